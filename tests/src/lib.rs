@@ -1,0 +1,1 @@
+//! yawcast-tests: cross-crate tests (host export → firmware native → firmware in QEMU).
