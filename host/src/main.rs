@@ -1,3 +1,4 @@
+//! The `yawcast` command-line tool.
 fn main() {
-    println!("Hello, world!");
+    println!("yawcast");
 }

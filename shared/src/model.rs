@@ -15,7 +15,8 @@
 //! ```
 //!
 //! `u` is the commanded pod/rudder angle (deg), `y` the yaw rate (deg/s). `ũ` is `u` after the
-//! actuator model: dead time, then rate limit, then saturation (each optional). Every effect that
+//! actuator model: dead time, then saturation of the delayed command, then the rate limit
+//! (the servo slews towards the saturated target), each optional. Every effect that
 //! "enters through B" adds `β φ(t)` to the effective input; `gyro-bias` is the output offset `d_y`.
 
 use heapless::Vec;

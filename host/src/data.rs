@@ -1,0 +1,462 @@
+//! Measurement records: the uniform-sampled time series every tool works on, and the CSV format.
+//!
+//! CSV header (units in the names): `t_s,delta_deg,r_degps[,psi_deg][,u_mps][,wind_speed_mps,wind_angle_deg]`.
+//! `delta_deg` is the *commanded* angle, held over `[t, t+Ts)`.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use thiserror::Error;
+
+/// Relative tolerance on the sample spacing before a record counts as non-uniform.
+pub const UNIFORM_TOL: f64 = 1e-3;
+
+/// One uniformly sampled record.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Record {
+    /// A name for reports (usually the file stem).
+    pub name: String,
+    /// Sample time in seconds.
+    pub ts: f64,
+    /// Time stamps (s).
+    pub t: Vec<f64>,
+    /// Commanded pod/rudder angle δ (deg).
+    pub u: Vec<f64>,
+    /// Measured yaw rate r (deg/s).
+    pub y: Vec<f64>,
+    /// Measured heading ψ (deg), when logged.
+    pub psi: Option<Vec<f64>>,
+    /// Speed over ground (m/s), when logged (`u_mps`).
+    pub speed: Option<Vec<f64>>,
+    /// Relative wind speed (m/s), when logged.
+    pub wind_speed: Option<Vec<f64>>,
+    /// Relative wind angle from the bow (deg), when logged.
+    pub wind_angle: Option<Vec<f64>>,
+}
+
+/// Errors reading or writing records.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum DataError {
+    /// The file could not be opened, read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// File concerned.
+        path: PathBuf,
+        /// Underlying error.
+        source: std::io::Error,
+    },
+    /// The CSV layer failed (quoting, ragged rows, …).
+    #[error("{path}: {message}")]
+    Csv {
+        /// File concerned.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// A required column is absent.
+    #[error("{path}: missing column `{column}` (found: {found})")]
+    MissingColumn {
+        /// File concerned.
+        path: PathBuf,
+        /// Expected column name.
+        column: String,
+        /// Columns actually present.
+        found: String,
+    },
+    /// A cell is not a finite number.
+    #[error("{path}: row {row}, column `{column}`: expected a finite number, found `{value}`")]
+    BadCell {
+        /// File concerned.
+        path: PathBuf,
+        /// 1-based data row (header is row 0).
+        row: usize,
+        /// Column name.
+        column: String,
+        /// Offending text.
+        value: String,
+    },
+    /// Time does not advance uniformly.
+    #[error("{path}: row {row}: time step {step} s breaks uniform sampling (expected {expected} s)")]
+    NonUniform {
+        /// File concerned.
+        path: PathBuf,
+        /// 1-based data row where the step ends.
+        row: usize,
+        /// Step found.
+        step: f64,
+        /// Step expected.
+        expected: f64,
+    },
+    /// Too few samples to be of any use.
+    #[error("{path}: {found} samples, at least {needed} needed")]
+    TooShort {
+        /// File concerned.
+        path: PathBuf,
+        /// Samples found.
+        found: usize,
+        /// Samples needed.
+        needed: usize,
+    },
+}
+
+impl Record {
+    /// Number of samples.
+    ///
+    /// ```
+    /// let r = yawcast::data::Record::from_uy("x", 1.0, vec![0.0; 3], vec![0.0; 3]);
+    /// assert_eq!(r.len(), 3);
+    /// ```
+    pub fn len(&self) -> usize {
+        self.y.len()
+    }
+
+    /// Whether the record holds no samples.
+    pub fn is_empty(&self) -> bool {
+        self.y.is_empty()
+    }
+
+    /// A record with only input and output; time starts at 0.
+    ///
+    /// ```
+    /// let r = yawcast::data::Record::from_uy("x", 0.5, vec![1.0, 2.0], vec![0.0, 0.1]);
+    /// assert_eq!(r.t, vec![0.0, 0.5]);
+    /// ```
+    pub fn from_uy(name: &str, ts: f64, u: Vec<f64>, y: Vec<f64>) -> Record {
+        let t = (0..y.len()).map(|i| i as f64 * ts).collect();
+        Record {
+            name: name.to_string(),
+            ts,
+            t,
+            u,
+            y,
+            ..Record::default()
+        }
+    }
+
+    /// Samples `start..end` as a new record (all channels).
+    ///
+    /// ```
+    /// let r = yawcast::data::Record::from_uy("x", 1.0, vec![1.0, 2.0, 3.0], vec![0.0; 3]);
+    /// assert_eq!(r.slice(1, 3).u, vec![2.0, 3.0]);
+    /// ```
+    pub fn slice(&self, start: usize, end: usize) -> Record {
+        let cut = |v: &Option<Vec<f64>>| v.as_ref().map(|v| v[start..end].to_vec());
+        Record {
+            name: self.name.clone(),
+            ts: self.ts,
+            t: self.t[start..end].to_vec(),
+            u: self.u[start..end].to_vec(),
+            y: self.y[start..end].to_vec(),
+            psi: cut(&self.psi),
+            speed: cut(&self.speed),
+            wind_speed: cut(&self.wind_speed),
+            wind_angle: cut(&self.wind_angle),
+        }
+    }
+}
+
+/// Column names of the measurement CSV (overridable for other loggers).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Columns {
+    /// Time (s).
+    pub t: String,
+    /// Commanded angle.
+    pub u: String,
+    /// Yaw rate.
+    pub y: String,
+    /// Heading (optional column).
+    pub psi: String,
+    /// Speed over ground (optional column).
+    pub speed: String,
+    /// Relative wind speed (optional column).
+    pub wind_speed: String,
+    /// Relative wind angle (optional column).
+    pub wind_angle: String,
+    /// Multiply the angle columns (`u`, `psi`, `wind_angle`) by this to get degrees.
+    pub angle_scale: f64,
+    /// Multiply the yaw-rate column by this to get deg/s.
+    pub rate_scale: f64,
+}
+
+impl Default for Columns {
+    fn default() -> Self {
+        Columns {
+            t: "t_s".into(),
+            u: "delta_deg".into(),
+            y: "r_degps".into(),
+            psi: "psi_deg".into(),
+            speed: "u_mps".into(),
+            wind_speed: "wind_speed_mps".into(),
+            wind_angle: "wind_angle_deg".into(),
+            angle_scale: 1.0,
+            rate_scale: 1.0,
+        }
+    }
+}
+
+/// Reads a measurement CSV with the default column names.
+///
+/// # Errors
+/// [`DataError`] naming the file, row and column for missing columns, non-numeric or
+/// non-finite cells, non-monotonic or non-uniform time, or fewer than 2 samples.
+pub fn read_csv(path: &Path) -> Result<Record, DataError> {
+    read_csv_with(path, &Columns::default())
+}
+
+/// Reads a measurement CSV with the given column names and unit scales.
+///
+/// # Errors
+/// As [`read_csv`].
+pub fn read_csv_with(path: &Path, cols: &Columns) -> Result<Record, DataError> {
+    let text = std::fs::read_to_string(path).map_err(|source| DataError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    parse_csv(&text, path, &name, cols)
+}
+
+/// Parses CSV text (`path` only labels errors).
+///
+/// # Errors
+/// As [`read_csv`].
+///
+/// ```
+/// use yawcast::data::{parse_csv, Columns};
+/// let txt = "t_s,delta_deg,r_degps\n0,1,0\n1,1,0.5\n2,-1,0.2\n";
+/// let r = parse_csv(txt, "x.csv".as_ref(), "x", &Columns::default()).unwrap();
+/// assert_eq!(r.ts, 1.0);
+/// assert_eq!(r.y, vec![0.0, 0.5, 0.2]);
+/// ```
+pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<Record, DataError> {
+    let csv_err = |e: csv::Error| DataError::Csv {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let mut rdr = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .comment(Some(b'#'))
+        .from_reader(text.as_bytes());
+    let headers: Vec<String> = rdr
+        .headers()
+        .map_err(csv_err)?
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let find = |c: &str| headers.iter().position(|h| h == c);
+    let need = |c: &str| {
+        find(c).ok_or_else(|| DataError::MissingColumn {
+            path: path.to_path_buf(),
+            column: c.to_string(),
+            found: headers.join(","),
+        })
+    };
+    let it = need(&cols.t)?;
+    let iu = need(&cols.u)?;
+    let iy = need(&cols.y)?;
+    let ipsi = find(&cols.psi);
+    let isp = find(&cols.speed);
+    let iws = find(&cols.wind_speed);
+    let iwa = find(&cols.wind_angle);
+    let mut rec = Record {
+        name: name.to_string(),
+        psi: ipsi.map(|_| Vec::new()),
+        speed: isp.map(|_| Vec::new()),
+        wind_speed: iws.map(|_| Vec::new()),
+        wind_angle: iwa.map(|_| Vec::new()),
+        ..Record::default()
+    };
+    for (i, row) in rdr.records().enumerate() {
+        let row = row.map_err(csv_err)?;
+        let rown = i + 1;
+        let cell = |idx: usize| -> Result<f64, DataError> {
+            let s = row.get(idx).unwrap_or("");
+            match s.parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(v),
+                _ => Err(DataError::BadCell {
+                    path: path.to_path_buf(),
+                    row: rown,
+                    column: headers[idx].clone(),
+                    value: s.to_string(),
+                }),
+            }
+        };
+        rec.t.push(cell(it)?);
+        rec.u.push(cell(iu)? * cols.angle_scale);
+        rec.y.push(cell(iy)? * cols.rate_scale);
+        if let (Some(i), Some(v)) = (ipsi, rec.psi.as_mut()) {
+            v.push(cell(i)? * cols.angle_scale);
+        }
+        if let (Some(i), Some(v)) = (isp, rec.speed.as_mut()) {
+            v.push(cell(i)?);
+        }
+        if let (Some(i), Some(v)) = (iws, rec.wind_speed.as_mut()) {
+            v.push(cell(i)?);
+        }
+        if let (Some(i), Some(v)) = (iwa, rec.wind_angle.as_mut()) {
+            v.push(cell(i)? * cols.angle_scale);
+        }
+    }
+    if rec.t.len() < 2 {
+        return Err(DataError::TooShort {
+            path: path.to_path_buf(),
+            found: rec.t.len(),
+            needed: 2,
+        });
+    }
+    rec.ts = check_uniform(&rec.t, path)?;
+    Ok(rec)
+}
+
+/// Checks that `t` advances by a constant positive step; returns the step.
+///
+/// # Errors
+/// [`DataError::NonUniform`] naming the first row that breaks the step.
+pub fn check_uniform(t: &[f64], path: &Path) -> Result<f64, DataError> {
+    let n = t.len();
+    let expected = (t[n - 1] - t[0]) / (n - 1) as f64;
+    let first = t[1] - t[0];
+    for i in 1..n {
+        let step = t[i] - t[i - 1];
+        let bad_sign = step <= 0.0 || expected <= 0.0;
+        if bad_sign || (step - first).abs() > UNIFORM_TOL * first.abs().max(1e-12) {
+            return Err(DataError::NonUniform {
+                path: path.to_path_buf(),
+                row: i + 1,
+                step,
+                expected: if expected > 0.0 { expected } else { first },
+            });
+        }
+    }
+    Ok(expected)
+}
+
+/// Writes a record as a measurement CSV, atomically (temp file, then rename).
+///
+/// # Errors
+/// [`DataError::Io`] when the file cannot be written.
+pub fn write_csv(path: &Path, rec: &Record) -> Result<(), DataError> {
+    let mut out = String::new();
+    out.push_str("t_s,delta_deg,r_degps");
+    let opt = [
+        (&rec.psi, "psi_deg"),
+        (&rec.speed, "u_mps"),
+        (&rec.wind_speed, "wind_speed_mps"),
+        (&rec.wind_angle, "wind_angle_deg"),
+    ];
+    for (v, name) in &opt {
+        if v.is_some() {
+            out.push(',');
+            out.push_str(name);
+        }
+    }
+    out.push('\n');
+    for i in 0..rec.len() {
+        out.push_str(&format!("{},{},{}", rec.t[i], rec.u[i], rec.y[i]));
+        for (v, _) in &opt {
+            if let Some(v) = v {
+                out.push_str(&format!(",{}", v[i]));
+            }
+        }
+        out.push('\n');
+    }
+    write_atomic(path, out.as_bytes())
+}
+
+/// Writes bytes to `path` through a temporary file in the same directory and a rename, so a
+/// reader never sees a half-written file.
+///
+/// # Errors
+/// [`DataError::Io`] when the file cannot be written or renamed.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), DataError> {
+    let io = |source| DataError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty());
+    if let Some(d) = dir {
+        std::fs::create_dir_all(d).map_err(io)?;
+    }
+    let fname = path
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
+    let tmp = path.with_file_name(format!(".{fname}.tmp{}", std::process::id()));
+    let res = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if res.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    res.map_err(io)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(txt: &str) -> Result<Record, DataError> {
+        parse_csv(txt, Path::new("f.csv"), "f", &Columns::default())
+    }
+
+    #[test]
+    fn reads_optional_columns() {
+        let r = parse("t_s,delta_deg,r_degps,psi_deg,u_mps\n0,1,0,10,1.5\n0.5,1,0.1,10.1,1.5\n")
+            .unwrap();
+        assert_eq!(r.ts, 0.5);
+        assert_eq!(r.psi, Some(vec![10.0, 10.1]));
+        assert_eq!(r.speed, Some(vec![1.5, 1.5]));
+        assert!(r.wind_speed.is_none());
+    }
+
+    #[test]
+    fn missing_column_is_named() {
+        let e = parse("t_s,delta_deg\n0,1\n1,1\n").unwrap_err().to_string();
+        assert!(e.contains("r_degps") && e.contains("f.csv"), "{e}");
+    }
+
+    #[test]
+    fn bad_cell_names_row_and_column() {
+        let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,x,0\n").unwrap_err().to_string();
+        assert!(e.contains("row 2") && e.contains("delta_deg") && e.contains("`x`"), "{e}");
+        let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,1,NaN\n").unwrap_err().to_string();
+        assert!(e.contains("r_degps") && e.contains("NaN"), "{e}");
+    }
+
+    #[test]
+    fn non_uniform_and_non_monotonic_time() {
+        let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,1,0\n2.5,1,0\n3.5,1,0\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("row 3"), "{e}");
+        let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,1,0\n0.5,1,0\n").unwrap_err();
+        assert!(matches!(e, DataError::NonUniform { row: 3, .. }), "{e}");
+    }
+
+    #[test]
+    fn round_trip_and_atomic_write() {
+        let dir = std::env::temp_dir().join(format!("yawcast-data-{}", std::process::id()));
+        let p = dir.join("r.csv");
+        let mut r = Record::from_uy("r", 0.25, vec![1.0, -2.5, 3.0], vec![0.125, 0.0, -1.0]);
+        r.psi = Some(vec![0.0, 1.0, 2.0]);
+        write_csv(&p, &r).unwrap();
+        let back = read_csv(&p).unwrap();
+        assert_eq!(back.u, r.u);
+        assert_eq!(back.y, r.y);
+        assert_eq!(back.psi, r.psi);
+        assert_eq!(back.ts, 0.25);
+        let leftovers: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .filter(|e| e.as_ref().unwrap().file_name().to_string_lossy().contains(".tmp"))
+            .collect();
+        assert!(leftovers.is_empty());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

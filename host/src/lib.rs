@@ -1,0 +1,5 @@
+//! yawcast: ship-trial data to a yaw-rate predictor — simulator, identification, tuning,
+//! diagnosis and export. f64 throughout; firmware-exact numbers come from `yawcast-firmware`.
+#![deny(missing_docs)]
+
+pub mod data;
