@@ -1,0 +1,602 @@
+//! The host's f64 model: canonical innovations form of order n plus library effects.
+//!
+//! Mirrors `yawcast_shared::model::ModelSpec` (the f32 export) with f64 numbers. The
+//! semantics of every effect are those of the firmware predictor; see [`crate::predict`].
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+use yawcast_shared::model::{self as sm, EffectKind, ModelSpec, Units};
+
+/// One library effect with f64 parameters (see `yawcast_shared::model::Effect` for physics).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "effect", rename_all = "kebab-case")]
+pub enum Effect {
+    /// Constant yaw moment: `φ = 1` through B.
+    Bias {
+        /// Gain β (deg of equivalent input).
+        beta: f64,
+    },
+    /// Rate-sensor offset `d_y` (deg/s).
+    GyroBias {
+        /// Output offset.
+        d_y: f64,
+    },
+    /// Command delay of `samples` whole samples.
+    DeadTime {
+        /// Delay (samples).
+        samples: usize,
+    },
+    /// Slew limit ρ (deg/s).
+    RateLimit {
+        /// ρ (deg/s).
+        rate: f64,
+    },
+    /// Angle limit δ_max (deg).
+    Saturation {
+        /// δ_max (deg).
+        limit: f64,
+    },
+    /// Port/starboard gain difference: `φ = max(ũ, 0)` through B.
+    Asymmetry {
+        /// Gain β.
+        beta: f64,
+    },
+    /// Nonlinear hull damping: `φ = y|y|` (or `y³`) through B.
+    NonlinearDamping {
+        /// Gain β.
+        beta: f64,
+        /// Cubic rather than `y|y|`.
+        cubic: bool,
+    },
+    /// Wind: `φ = (sin 2ψ, cos 2ψ, sin ψ, cos ψ)` through B.
+    Wind {
+        /// Gain of sin 2ψ.
+        beta_s2: f64,
+        /// Gain of cos 2ψ.
+        beta_c2: f64,
+        /// Gain of sin ψ.
+        beta_s1: f64,
+        /// Gain of cos ψ.
+        beta_c1: f64,
+    },
+    /// Current: `φ = (sin ψ, cos ψ)` through B.
+    Current {
+        /// Gain of sin ψ.
+        beta_s: f64,
+        /// Gain of cos ψ.
+        beta_c: f64,
+    },
+}
+
+impl Effect {
+    /// The effect's kind.
+    ///
+    /// ```
+    /// use yawcast::model::Effect;
+    /// assert_eq!(Effect::Bias { beta: 1.0 }.kind().name(), "bias");
+    /// ```
+    pub fn kind(&self) -> EffectKind {
+        match self {
+            Effect::Bias { .. } => EffectKind::Bias,
+            Effect::GyroBias { .. } => EffectKind::GyroBias,
+            Effect::DeadTime { .. } => EffectKind::DeadTime,
+            Effect::RateLimit { .. } => EffectKind::RateLimit,
+            Effect::Saturation { .. } => EffectKind::Saturation,
+            Effect::Asymmetry { .. } => EffectKind::Asymmetry,
+            Effect::NonlinearDamping { .. } => EffectKind::NonlinearDamping,
+            Effect::Wind { .. } => EffectKind::Wind,
+            Effect::Current { .. } => EffectKind::Current,
+        }
+    }
+
+    /// The effect of `kind` with zero gains (linear parameters to be estimated) and the
+    /// given structural parameter where one is needed (dead time samples, rate, limit).
+    ///
+    /// ```
+    /// use yawcast::model::Effect;
+    /// use yawcast_shared::model::EffectKind;
+    /// assert_eq!(Effect::zero(EffectKind::Current, 0.0), Effect::Current { beta_s: 0.0, beta_c: 0.0 });
+    /// assert_eq!(Effect::zero(EffectKind::DeadTime, 2.0), Effect::DeadTime { samples: 2 });
+    /// ```
+    pub fn zero(kind: EffectKind, structural: f64) -> Effect {
+        match kind {
+            EffectKind::Bias => Effect::Bias { beta: 0.0 },
+            EffectKind::GyroBias => Effect::GyroBias { d_y: 0.0 },
+            EffectKind::DeadTime => Effect::DeadTime {
+                samples: structural.round().max(0.0) as usize,
+            },
+            EffectKind::RateLimit => Effect::RateLimit { rate: structural },
+            EffectKind::Saturation => Effect::Saturation { limit: structural },
+            EffectKind::Asymmetry => Effect::Asymmetry { beta: 0.0 },
+            EffectKind::NonlinearDamping => Effect::NonlinearDamping {
+                beta: 0.0,
+                cubic: false,
+            },
+            EffectKind::Wind => Effect::Wind {
+                beta_s2: 0.0,
+                beta_c2: 0.0,
+                beta_s1: 0.0,
+                beta_c1: 0.0,
+            },
+            _ => Effect::Current {
+                beta_s: 0.0,
+                beta_c: 0.0,
+            },
+        }
+    }
+
+    /// The linear gains this effect adds to the parameter vector (empty for actuator effects).
+    ///
+    /// ```
+    /// use yawcast::model::Effect;
+    /// assert_eq!(Effect::Current { beta_s: 1.0, beta_c: 2.0 }.gains(), vec![1.0, 2.0]);
+    /// ```
+    pub fn gains(&self) -> Vec<f64> {
+        match *self {
+            Effect::Bias { beta } | Effect::Asymmetry { beta } => vec![beta],
+            Effect::NonlinearDamping { beta, .. } => vec![beta],
+            Effect::GyroBias { d_y } => vec![d_y],
+            Effect::Wind {
+                beta_s2,
+                beta_c2,
+                beta_s1,
+                beta_c1,
+            } => vec![beta_s2, beta_c2, beta_s1, beta_c1],
+            Effect::Current { beta_s, beta_c } => vec![beta_s, beta_c],
+            Effect::DeadTime { .. } | Effect::RateLimit { .. } | Effect::Saturation { .. } => {
+                vec![]
+            }
+        }
+    }
+
+    /// Sets the linear gains from `g` (length as returned by [`Effect::gains`]).
+    pub fn set_gains(&mut self, g: &[f64]) {
+        match self {
+            Effect::Bias { beta } | Effect::Asymmetry { beta } => *beta = g[0],
+            Effect::NonlinearDamping { beta, .. } => *beta = g[0],
+            Effect::GyroBias { d_y } => *d_y = g[0],
+            Effect::Wind {
+                beta_s2,
+                beta_c2,
+                beta_s1,
+                beta_c1,
+            } => {
+                *beta_s2 = g[0];
+                *beta_c2 = g[1];
+                *beta_s1 = g[2];
+                *beta_c1 = g[3];
+            }
+            Effect::Current { beta_s, beta_c } => {
+                *beta_s = g[0];
+                *beta_c = g[1];
+            }
+            Effect::DeadTime { .. } | Effect::RateLimit { .. } | Effect::Saturation { .. } => {}
+        }
+    }
+
+    fn to_spec(self) -> sm::Effect {
+        match self {
+            Effect::Bias { beta } => sm::Effect::Bias { beta: beta as f32 },
+            Effect::GyroBias { d_y } => sm::Effect::GyroBias { d_y: d_y as f32 },
+            Effect::DeadTime { samples } => sm::Effect::DeadTime {
+                samples: samples.min(255) as u8,
+            },
+            Effect::RateLimit { rate } => sm::Effect::RateLimit { rate: rate as f32 },
+            Effect::Saturation { limit } => sm::Effect::Saturation {
+                limit: limit as f32,
+            },
+            Effect::Asymmetry { beta } => sm::Effect::Asymmetry { beta: beta as f32 },
+            Effect::NonlinearDamping { beta, cubic } => sm::Effect::NonlinearDamping {
+                beta: beta as f32,
+                cubic,
+            },
+            Effect::Wind {
+                beta_s2,
+                beta_c2,
+                beta_s1,
+                beta_c1,
+            } => sm::Effect::Wind {
+                beta_s2: beta_s2 as f32,
+                beta_c2: beta_c2 as f32,
+                beta_s1: beta_s1 as f32,
+                beta_c1: beta_c1 as f32,
+            },
+            Effect::Current { beta_s, beta_c } => sm::Effect::Current {
+                beta_s: beta_s as f32,
+                beta_c: beta_c as f32,
+            },
+        }
+    }
+
+    fn from_spec(e: &sm::Effect) -> Option<Effect> {
+        Some(match *e {
+            sm::Effect::Bias { beta } => Effect::Bias { beta: beta.into() },
+            sm::Effect::GyroBias { d_y } => Effect::GyroBias { d_y: d_y.into() },
+            sm::Effect::DeadTime { samples } => Effect::DeadTime {
+                samples: samples.into(),
+            },
+            sm::Effect::RateLimit { rate } => Effect::RateLimit { rate: rate.into() },
+            sm::Effect::Saturation { limit } => Effect::Saturation {
+                limit: limit.into(),
+            },
+            sm::Effect::Asymmetry { beta } => Effect::Asymmetry { beta: beta.into() },
+            sm::Effect::NonlinearDamping { beta, cubic } => Effect::NonlinearDamping {
+                beta: beta.into(),
+                cubic,
+            },
+            sm::Effect::Wind {
+                beta_s2,
+                beta_c2,
+                beta_s1,
+                beta_c1,
+            } => Effect::Wind {
+                beta_s2: beta_s2.into(),
+                beta_c2: beta_c2.into(),
+                beta_s1: beta_s1.into(),
+                beta_c1: beta_c1.into(),
+            },
+            sm::Effect::Current { beta_s, beta_c } => Effect::Current {
+                beta_s: beta_s.into(),
+                beta_c: beta_c.into(),
+            },
+            #[allow(unreachable_patterns)]
+            _ => return None,
+        })
+    }
+}
+
+/// Errors building or converting models.
+#[derive(Debug, Error, PartialEq)]
+#[non_exhaustive]
+pub enum ModelError {
+    /// Order outside 2..=8.
+    #[error("model order {0} is outside 2..=8")]
+    Order(usize),
+    /// a, b or k has the wrong length.
+    #[error("parameter vector `{name}` has {found} values, the order is {order}")]
+    Length {
+        /// Which vector.
+        name: &'static str,
+        /// Its length.
+        found: usize,
+        /// The order.
+        order: usize,
+    },
+    /// A number is NaN or infinite.
+    #[error("parameter `{0}` is not finite")]
+    NonFinite(String),
+    /// The sample time is not positive.
+    #[error("sample time {0} s is not positive")]
+    SampleTime(f64),
+    /// Two effects of the same kind.
+    #[error("effect `{0}` appears twice")]
+    DuplicateEffect(&'static str),
+    /// The f32 export was refused by the shared schema.
+    #[error("the model cannot be exported: {0}")]
+    Export(String),
+}
+
+/// A linear canonical innovations model of order `n` with optional effects (f64).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Model {
+    /// Order n.
+    pub n: usize,
+    /// Sample time (s).
+    pub ts: f64,
+    /// Last row of the companion matrix A: `x_n(t+1) = Σ a_i x_i(t) + …`.
+    pub a: Vec<f64>,
+    /// Input vector B.
+    pub b: Vec<f64>,
+    /// Kalman gain K.
+    pub k: Vec<f64>,
+    /// Library effects, at most one of each kind.
+    #[serde(default)]
+    pub effects: Vec<Effect>,
+}
+
+impl Model {
+    /// Builds and validates a model with no effects.
+    ///
+    /// # Errors
+    /// [`ModelError`] for a bad order, wrong lengths, non-finite numbers or `ts ≤ 0`.
+    ///
+    /// ```
+    /// use yawcast::model::Model;
+    /// let m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.3, 0.1]).unwrap();
+    /// assert_eq!(m.n, 2);
+    /// assert!(Model::new(1.0, vec![0.5], vec![0.1], vec![0.3]).is_err());
+    /// ```
+    pub fn new(ts: f64, a: Vec<f64>, b: Vec<f64>, k: Vec<f64>) -> Result<Model, ModelError> {
+        let m = Model {
+            n: a.len(),
+            ts,
+            a,
+            b,
+            k,
+            effects: Vec::new(),
+        };
+        m.validate()?;
+        Ok(m)
+    }
+
+    /// Checks order, lengths, finiteness and effect uniqueness.
+    ///
+    /// # Errors
+    /// See [`ModelError`].
+    pub fn validate(&self) -> Result<(), ModelError> {
+        if !(2..=8).contains(&self.n) {
+            return Err(ModelError::Order(self.n));
+        }
+        for (name, v) in [("a", &self.a), ("b", &self.b), ("k", &self.k)] {
+            if v.len() != self.n {
+                return Err(ModelError::Length {
+                    name,
+                    found: v.len(),
+                    order: self.n,
+                });
+            }
+            if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+                return Err(ModelError::NonFinite(format!("{name}{}", i + 1)));
+            }
+        }
+        if !(self.ts > 0.0 && self.ts.is_finite()) {
+            return Err(ModelError::SampleTime(self.ts));
+        }
+        for (i, e) in self.effects.iter().enumerate() {
+            if self.effects[..i].iter().any(|f| f.kind() == e.kind()) {
+                return Err(ModelError::DuplicateEffect(e.kind().name()));
+            }
+            if e.gains().iter().any(|g| !g.is_finite()) {
+                return Err(ModelError::NonFinite(e.kind().name().into()));
+            }
+        }
+        Ok(())
+    }
+
+    /// θ = (a1..an, b1..bn, k1..kn).
+    ///
+    /// ```
+    /// use yawcast::model::Model;
+    /// let m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.3, 0.1]).unwrap();
+    /// assert_eq!(m.theta(), vec![0.0, 0.5, 0.1, 0.2, 0.3, 0.1]);
+    /// ```
+    pub fn theta(&self) -> Vec<f64> {
+        let mut t = Vec::with_capacity(3 * self.n);
+        t.extend_from_slice(&self.a);
+        t.extend_from_slice(&self.b);
+        t.extend_from_slice(&self.k);
+        t
+    }
+
+    /// Sets θ (length 3n).
+    pub fn set_theta(&mut self, theta: &[f64]) {
+        let n = self.n;
+        self.a.copy_from_slice(&theta[..n]);
+        self.b.copy_from_slice(&theta[n..2 * n]);
+        self.k.copy_from_slice(&theta[2 * n..3 * n]);
+    }
+
+    /// Parameter names in θ order followed by effect gains: `a1.., b1.., k1.., <effect>.<gain>`.
+    ///
+    /// ```
+    /// use yawcast::model::{Effect, Model};
+    /// let mut m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.3, 0.1]).unwrap();
+    /// m.effects.push(Effect::Bias { beta: 0.0 });
+    /// assert_eq!(m.param_names().last().unwrap(), "bias.beta");
+    /// ```
+    pub fn param_names(&self) -> Vec<String> {
+        let mut v = Vec::new();
+        for p in ["a", "b", "k"] {
+            for i in 1..=self.n {
+                v.push(format!("{p}{i}"));
+            }
+        }
+        for e in &self.effects {
+            let names: &[&str] = match e {
+                Effect::Bias { .. } | Effect::Asymmetry { .. } => &["beta"],
+                Effect::NonlinearDamping { .. } => &["beta"],
+                Effect::GyroBias { .. } => &["d_y"],
+                Effect::Wind { .. } => &["beta_s2", "beta_c2", "beta_s1", "beta_c1"],
+                Effect::Current { .. } => &["beta_s", "beta_c"],
+                _ => &[],
+            };
+            for g in names {
+                v.push(format!("{}.{g}", e.kind().name()));
+            }
+        }
+        v
+    }
+
+    /// All linear effect gains, in effect order.
+    pub fn effect_gains(&self) -> Vec<f64> {
+        self.effects.iter().flat_map(|e| e.gains()).collect()
+    }
+
+    /// Sets all linear effect gains (length as [`Model::effect_gains`]).
+    pub fn set_effect_gains(&mut self, g: &[f64]) {
+        let mut at = 0;
+        for e in &mut self.effects {
+            let len = e.gains().len();
+            e.set_gains(&g[at..at + len]);
+            at += len;
+        }
+    }
+
+    /// The effect of `kind`, if present.
+    pub fn effect(&self, kind: EffectKind) -> Option<&Effect> {
+        self.effects.iter().find(|e| e.kind() == kind)
+    }
+
+    /// Adds `e`, replacing an effect of the same kind.
+    pub fn with_effect(mut self, e: Effect) -> Model {
+        self.effects.retain(|f| f.kind() != e.kind());
+        self.effects.push(e);
+        self
+    }
+
+    /// Output offset `d_y` (gyro bias), 0 when absent.
+    pub fn d_y(&self) -> f64 {
+        match self.effect(EffectKind::GyroBias) {
+            Some(Effect::GyroBias { d_y }) => *d_y,
+            _ => 0.0,
+        }
+    }
+
+    /// Spectral radius of A and of A − KC (the predictor), computed from the companion
+    /// polynomials' eigenvalues.
+    ///
+    /// ```
+    /// use yawcast::model::Model;
+    /// // x2' = 0.5 x1 ... companion with a = [0.25, 0]: eigenvalues ±0.5
+    /// let m = Model::new(1.0, vec![0.25, 0.0], vec![0.0, 1.0], vec![0.0, 0.0]).unwrap();
+    /// let (ra, rp) = m.spectral_radii();
+    /// assert!((ra - 0.5).abs() < 1e-12 && (rp - 0.5).abs() < 1e-12);
+    /// ```
+    pub fn spectral_radii(&self) -> (f64, f64) {
+        (
+            spectral_radius(&self.a_matrix()),
+            spectral_radius(&self.predictor_matrix()),
+        )
+    }
+
+    /// Whether A and A − KC are both strictly stable (spectral radius < 1).
+    pub fn is_stable(&self) -> bool {
+        let (a, p) = self.spectral_radii();
+        a < 1.0 && p < 1.0
+    }
+
+    /// The companion matrix A.
+    pub fn a_matrix(&self) -> nalgebra::DMatrix<f64> {
+        let n = self.n;
+        let mut m = nalgebra::DMatrix::zeros(n, n);
+        for i in 0..n - 1 {
+            m[(i, i + 1)] = 1.0;
+        }
+        for j in 0..n {
+            m[(n - 1, j)] = self.a[j];
+        }
+        m
+    }
+
+    /// The predictor matrix A − K C (C = e₁ᵀ).
+    pub fn predictor_matrix(&self) -> nalgebra::DMatrix<f64> {
+        let mut m = self.a_matrix();
+        for i in 0..self.n {
+            m[(i, 0)] -= self.k[i];
+        }
+        m
+    }
+
+    /// Converts to the f32 export schema (validated by the shared crate).
+    ///
+    /// # Errors
+    /// [`ModelError::Export`] when the shared schema refuses the model (e.g. unstable).
+    pub fn to_spec(&self) -> Result<ModelSpec, ModelError> {
+        let cvt = |v: &[f64]| -> heapless::Vec<f32, { sm::MAX_ORDER }> {
+            v.iter().map(|x| *x as f32).collect()
+        };
+        let mut effects = heapless::Vec::new();
+        for e in &self.effects {
+            effects
+                .push(e.to_spec())
+                .map_err(|_| ModelError::Export("too many effects".into()))?;
+        }
+        let spec = ModelSpec {
+            order: self.n as u8,
+            ts: self.ts as f32,
+            a: cvt(&self.a),
+            b: cvt(&self.b),
+            k: cvt(&self.k),
+            units: Units::default(),
+            effects,
+        };
+        Ok(spec)
+    }
+
+    /// Converts from the f32 export schema.
+    ///
+    /// # Errors
+    /// [`ModelError`] when the converted model does not validate.
+    pub fn from_spec(spec: &ModelSpec) -> Result<Model, ModelError> {
+        let f = |v: &[f32]| v.iter().map(|x| f64::from(*x)).collect::<Vec<_>>();
+        let m = Model {
+            n: spec.order as usize,
+            ts: spec.ts.into(),
+            a: f(&spec.a),
+            b: f(&spec.b),
+            k: f(&spec.k),
+            effects: spec.effects.iter().filter_map(Effect::from_spec).collect(),
+        };
+        m.validate()?;
+        Ok(m)
+    }
+}
+
+/// Largest eigenvalue modulus of a square matrix.
+pub fn spectral_radius(m: &nalgebra::DMatrix<f64>) -> f64 {
+    m.complex_eigenvalues()
+        .iter()
+        .map(|z| z.norm())
+        .fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn theta_round_trip_and_names() {
+        let mut m = Model::new(
+            1.0,
+            vec![0.1, 0.2, 0.3, 0.4],
+            vec![1.0, 2.0, 3.0, 4.0],
+            vec![0.5, 0.6, 0.7, 0.8],
+        )
+        .unwrap();
+        let th: Vec<f64> = (0..12).map(|i| i as f64).collect();
+        m.set_theta(&th);
+        assert_eq!(m.theta(), th);
+        assert_eq!(m.param_names()[4], "b1");
+        assert_eq!(m.param_names()[11], "k4");
+    }
+
+    #[test]
+    fn effect_gains_round_trip() {
+        let mut m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.3, 0.1]).unwrap();
+        m = m
+            .with_effect(Effect::zero(EffectKind::Wind, 0.0))
+            .with_effect(Effect::DeadTime { samples: 2 })
+            .with_effect(Effect::Bias { beta: 0.0 });
+        m.set_effect_gains(&[1.0, 2.0, 3.0, 4.0, 5.0]);
+        assert_eq!(m.effect_gains(), vec![1.0, 2.0, 3.0, 4.0, 5.0]);
+        assert_eq!(
+            m.effect(EffectKind::Bias),
+            Some(&Effect::Bias { beta: 5.0 })
+        );
+        m.effects.push(Effect::Bias { beta: 1.0 });
+        assert_eq!(m.validate(), Err(ModelError::DuplicateEffect("bias")));
+    }
+
+    #[test]
+    fn spectral_radius_of_predictor() {
+        // A − KC for n = 2: [[-k1, 1], [a1 - k2, a2]]
+        let m = Model::new(1.0, vec![-0.5, 1.0], vec![0.0, 1.0], vec![0.5, 0.0]).unwrap();
+        let (ra, rp) = m.spectral_radii();
+        // A: z² − z + 0.5 → |z| = √0.5
+        assert!((ra - 0.5f64.sqrt()).abs() < 1e-12);
+        // A−KC: [[-0.5, 1], [-0.5, 1]] → z² − 0.5 z + 0 → {0, 0.5}
+        assert!((rp - 0.5).abs() < 1e-12);
+        assert!(m.is_stable());
+    }
+
+    #[test]
+    fn json_twin_uses_stable_effect_names() {
+        let m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.3, 0.1])
+            .unwrap()
+            .with_effect(Effect::RateLimit { rate: 3.0 });
+        let s = serde_json::to_string(&m).unwrap();
+        assert!(s.contains("\"effect\":\"rate-limit\""), "{s}");
+        let back: Model = serde_json::from_str(&s).unwrap();
+        assert_eq!(back, m);
+    }
+}

@@ -1,0 +1,501 @@
+//! f64 predictors: one-step (Kalman-gain) filter, k-step prediction, pure simulation, fit %.
+//!
+//! The step semantics are exactly those of the firmware's `Predictor` (in f64 rather than f32):
+//!
+//! 1. actuator: `delayed = u(t−d)`; `target = clamp(delayed, ±limit)`;
+//!    `ũ = ũ_prev + clamp(target − ũ_prev, ±ρ·Ts)` (or `target` without a rate limit);
+//! 2. heading `ψ` = measured ψ when given, else the integrated `ψ̂`;
+//! 3. `y_used` = measured y when finite, else `ŷ = x̂₁ + d_y`;
+//! 4. `v = ũ + Σ β φ` (bias 1, asymmetry max(ũ,0), damping y|y| or y³, wind sin2ψ, cos2ψ,
+//!    sinψ, cosψ, current sinψ, cosψ; ψ in degrees);
+//! 5. `e = y − ŷ` (0 when y is missing);
+//! 6. `x̂' = A x̂ + B v + K e`;
+//! 7. `ψ̂' = ψ + Ts·(y_used − d_y)`.
+//!
+//! k-step prediction (MATLAB `predict`): `ŷ(t|t−k)` starts from the one-step state
+//! `x̂(t−k+1|t−k)` and runs k−1 open-loop steps (no measurements, `e = 0`, `y_used = ŷ`).
+//! The first k samples are pure simulation from `x̂(0)`.
+
+use crate::data::Record;
+use crate::model::{Effect, Model};
+
+/// Largest order handled (matches the shared schema).
+pub const MAX_N: usize = 8;
+
+/// A prediction horizon: k steps ahead, or pure simulation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Horizon {
+    /// k-step-ahead prediction, k ≥ 1.
+    Steps(usize),
+    /// Pure simulation from x̂(0): no measurement is ever used.
+    Sim,
+}
+
+impl Horizon {
+    /// The JSON/CLI key: `"5"` or `"sim"`.
+    ///
+    /// ```
+    /// use yawcast::predict::Horizon;
+    /// assert_eq!(Horizon::Steps(5).key(), "5");
+    /// assert_eq!(Horizon::Sim.key(), "sim");
+    /// ```
+    pub fn key(&self) -> String {
+        match self {
+            Horizon::Steps(k) => k.to_string(),
+            Horizon::Sim => "sim".into(),
+        }
+    }
+
+    /// Parses `"5"` or `"sim"`; `None` for anything else (including 0).
+    ///
+    /// ```
+    /// use yawcast::predict::Horizon;
+    /// assert_eq!(Horizon::parse("sim"), Some(Horizon::Sim));
+    /// assert_eq!(Horizon::parse("10"), Some(Horizon::Steps(10)));
+    /// assert_eq!(Horizon::parse("0"), None);
+    /// ```
+    pub fn parse(s: &str) -> Option<Horizon> {
+        match s.trim() {
+            "sim" => Some(Horizon::Sim),
+            t => t.parse().ok().filter(|k| *k >= 1).map(Horizon::Steps),
+        }
+    }
+
+    /// The default report horizons: 1, 5, 10, 20 and sim.
+    pub const REPORT: [Horizon; 5] = [
+        Horizon::Steps(1),
+        Horizon::Steps(5),
+        Horizon::Steps(10),
+        Horizon::Steps(20),
+        Horizon::Sim,
+    ];
+}
+
+/// Full predictor state: x̂, the delay line, the actuator position and the heading.
+#[derive(Debug, Clone, PartialEq)]
+pub struct State {
+    /// State estimate x̂ (first `n` entries used).
+    pub x: [f64; MAX_N],
+    /// Delay line of the last d commands (oldest first).
+    pub delay: Vec<f64>,
+    /// Actuator position ũ_prev.
+    pub u_prev: f64,
+    /// Integrated heading ψ̂ (deg).
+    pub psi: f64,
+}
+
+/// The model's effects unpacked for fast stepping.
+#[derive(Debug, Clone, Default)]
+pub struct Stepper {
+    n: usize,
+    a: [f64; MAX_N],
+    b: [f64; MAX_N],
+    k: [f64; MAX_N],
+    ts: f64,
+    d: usize,
+    rate: Option<f64>,
+    limit: Option<f64>,
+    d_y: f64,
+    bias: f64,
+    asym: f64,
+    damp: f64,
+    cubic: bool,
+    wind: [f64; 4],
+    current: [f64; 2],
+    heading: bool,
+}
+
+/// What one filter step returns.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepOut {
+    /// The prediction ŷ(t|t−1) made before the step.
+    pub yhat: f64,
+    /// The actuator output ũ(t).
+    pub u_eff: f64,
+    /// The effective input v(t) = ũ + Σβφ.
+    pub v: f64,
+}
+
+impl Stepper {
+    /// Unpacks `model` (assumed validated).
+    pub fn new(model: &Model) -> Stepper {
+        let n = model.n.min(MAX_N);
+        let mut s = Stepper {
+            n,
+            ts: model.ts,
+            ..Stepper::default()
+        };
+        s.a[..n].copy_from_slice(&model.a[..n]);
+        s.b[..n].copy_from_slice(&model.b[..n]);
+        s.k[..n].copy_from_slice(&model.k[..n]);
+        for e in &model.effects {
+            match *e {
+                Effect::Bias { beta } => s.bias = beta,
+                Effect::GyroBias { d_y } => s.d_y = d_y,
+                Effect::DeadTime { samples } => s.d = samples,
+                Effect::RateLimit { rate } => s.rate = Some(rate),
+                Effect::Saturation { limit } => s.limit = Some(limit),
+                Effect::Asymmetry { beta } => s.asym = beta,
+                Effect::NonlinearDamping { beta, cubic } => {
+                    s.damp = beta;
+                    s.cubic = cubic;
+                }
+                Effect::Wind {
+                    beta_s2,
+                    beta_c2,
+                    beta_s1,
+                    beta_c1,
+                } => {
+                    s.wind = [beta_s2, beta_c2, beta_s1, beta_c1];
+                    s.heading = true;
+                }
+                Effect::Current { beta_s, beta_c } => {
+                    s.current = [beta_s, beta_c];
+                    s.heading = true;
+                }
+            }
+        }
+        s
+    }
+
+    /// The initial state with x̂ = `x0` (zeros beyond its length) and `ψ̂ = psi0`.
+    pub fn initial(&self, x0: &[f64], psi0: f64) -> State {
+        let mut x = [0.0; MAX_N];
+        for (xi, v) in x.iter_mut().zip(x0.iter()).take(self.n) {
+            *xi = *v;
+        }
+        State {
+            x,
+            delay: vec![0.0; self.d],
+            u_prev: 0.0,
+            psi: psi0,
+        }
+    }
+
+    /// Output offset d_y.
+    pub fn d_y(&self) -> f64 {
+        self.d_y
+    }
+
+    /// ŷ = x̂₁ + d_y for a state.
+    pub fn output(&self, st: &State) -> f64 {
+        st.x[0] + self.d_y
+    }
+
+    /// Runs the actuator chain on command `u`, advancing its state; returns ũ.
+    pub fn actuator(&self, st: &mut State, u: f64) -> f64 {
+        let delayed = if self.d > 0 {
+            let out = st.delay[0];
+            st.delay.rotate_left(1);
+            st.delay[self.d - 1] = u;
+            out
+        } else {
+            u
+        };
+        let target = match self.limit {
+            Some(l) => delayed.clamp(-l, l),
+            None => delayed,
+        };
+        let ut = match self.rate {
+            Some(r) => {
+                let step = r * self.ts;
+                st.u_prev + (target - st.u_prev).clamp(-step, step)
+            }
+            None => target,
+        };
+        st.u_prev = ut;
+        ut
+    }
+
+    /// The effect regressor sum Σβφ for actuator output `ut`, output `y_used`, heading `psi` (deg).
+    pub fn effects_sum(&self, ut: f64, y_used: f64, psi: f64) -> f64 {
+        let mut s = self.bias;
+        if self.asym != 0.0 {
+            s += self.asym * ut.max(0.0);
+        }
+        if self.damp != 0.0 {
+            let phi = if self.cubic {
+                y_used * y_used * y_used
+            } else {
+                y_used * y_used.abs()
+            };
+            s += self.damp * phi;
+        }
+        if self.heading {
+            let p = psi.to_radians();
+            let (s1, c1) = p.sin_cos();
+            let (s2, c2) = (2.0 * p).sin_cos();
+            s += self.wind[0] * s2 + self.wind[1] * c2 + self.wind[2] * s1 + self.wind[3] * c1;
+            s += self.current[0] * s1 + self.current[1] * c1;
+        }
+        s
+    }
+
+    /// One filter step with command `u`, measurement `y` (NaN = missing) and optional
+    /// measured heading. Returns the prediction made before the step.
+    pub fn step(&self, st: &mut State, u: f64, y: f64, psi_meas: Option<f64>) -> StepOut {
+        let yhat = self.output(st);
+        let ut = self.actuator(st, u);
+        let psi = match psi_meas {
+            Some(p) if p.is_finite() => p,
+            _ => st.psi,
+        };
+        let (y_used, e) = if y.is_finite() {
+            (y, y - yhat)
+        } else {
+            (yhat, 0.0)
+        };
+        let v = ut + self.effects_sum(ut, y_used, psi);
+        let n = self.n;
+        let x = st.x;
+        let mut last = 0.0;
+        for i in 0..n {
+            last += self.a[i] * x[i];
+        }
+        for i in 0..n - 1 {
+            st.x[i] = x[i + 1] + self.b[i] * v + self.k[i] * e;
+        }
+        st.x[n - 1] = last + self.b[n - 1] * v + self.k[n - 1] * e;
+        st.psi = psi + self.ts * (y_used - self.d_y);
+        StepOut { yhat, u_eff: ut, v }
+    }
+}
+
+fn psi_at(rec: &Record, t: usize) -> Option<f64> {
+    rec.psi.as_ref().map(|p| p[t])
+}
+
+fn psi0(rec: &Record) -> f64 {
+    psi_at(rec, 0).unwrap_or(0.0)
+}
+
+/// One-step predictions ŷ(t|t−1) for every sample, from x̂(0) = `x0`.
+///
+/// ```
+/// use yawcast::{data::Record, model::Model, predict};
+/// let m = Model::new(1.0, vec![0.0, 0.5], vec![1.0, 0.5], vec![0.0, 0.0]).unwrap();
+/// let r = Record::from_uy("x", 1.0, vec![1.0; 4], vec![0.0; 4]);
+/// // K = 0: pure simulation; x1(1) = b1·u = 1.
+/// assert_eq!(predict::one_step(&m, &r, &[0.0, 0.0]), vec![0.0, 1.0, 1.5, 1.5]);
+/// ```
+pub fn one_step(model: &Model, rec: &Record, x0: &[f64]) -> Vec<f64> {
+    let s = Stepper::new(model);
+    let mut st = s.initial(x0, psi0(rec));
+    (0..rec.len())
+        .map(|t| s.step(&mut st, rec.u[t], rec.y[t], psi_at(rec, t)).yhat)
+        .collect()
+}
+
+/// k-step-ahead predictions ŷ(t|t−k) for every sample (k ≥ 1).
+pub fn k_step(model: &Model, rec: &Record, x0: &[f64], k: usize) -> Vec<f64> {
+    let k = k.max(1);
+    let s = Stepper::new(model);
+    let n = rec.len();
+    // states[t] = state before processing sample t, i.e. x̂(t|t−1).
+    let mut st = s.initial(x0, psi0(rec));
+    let mut states = Vec::with_capacity(n);
+    for t in 0..n {
+        states.push(st.clone());
+        s.step(&mut st, rec.u[t], rec.y[t], psi_at(rec, t));
+    }
+    let mut out = Vec::with_capacity(n);
+    for t in 0..n {
+        let start = (t + 1).saturating_sub(k);
+        let mut w = states[start].clone();
+        for j in start..t {
+            s.step(&mut w, rec.u[j], f64::NAN, None);
+        }
+        out.push(s.output(&w));
+    }
+    out
+}
+
+/// Pure simulation from x̂(0) = `x0` (no measurement used; heading integrated from the
+/// simulated rate, starting at the measured ψ(0) when logged).
+pub fn simulate(model: &Model, rec: &Record, x0: &[f64]) -> Vec<f64> {
+    let s = Stepper::new(model);
+    let mut st = s.initial(x0, psi0(rec));
+    (0..rec.len())
+        .map(|t| s.step(&mut st, rec.u[t], f64::NAN, None).yhat)
+        .collect()
+}
+
+/// Predictions at horizon `h`.
+pub fn predict(model: &Model, rec: &Record, x0: &[f64], h: Horizon) -> Vec<f64> {
+    match h {
+        Horizon::Steps(1) => one_step(model, rec, x0),
+        Horizon::Steps(k) => k_step(model, rec, x0, k),
+        Horizon::Sim => simulate(model, rec, x0),
+    }
+}
+
+/// MATLAB `compare` fit: `100·(1 − ‖y − ŷ‖/‖y − mean(y)‖)`. Non-finite predictions give −∞.
+///
+/// ```
+/// use yawcast::predict::fit;
+/// assert_eq!(fit(&[1.0, 2.0, 3.0], &[1.0, 2.0, 3.0]), 100.0);
+/// assert_eq!(fit(&[1.0, 2.0, 3.0], &[2.0, 2.0, 2.0]), 0.0);
+/// ```
+pub fn fit(y: &[f64], yhat: &[f64]) -> f64 {
+    let n = y.len().min(yhat.len());
+    if n == 0 {
+        return f64::NEG_INFINITY;
+    }
+    let mean = y[..n].iter().sum::<f64>() / n as f64;
+    let mut num = 0.0;
+    let mut den = 0.0;
+    for i in 0..n {
+        num += (y[i] - yhat[i]).powi(2);
+        den += (y[i] - mean).powi(2);
+    }
+    if !num.is_finite() {
+        return f64::NEG_INFINITY;
+    }
+    if den == 0.0 {
+        return if num == 0.0 { 100.0 } else { f64::NEG_INFINITY };
+    }
+    100.0 * (1.0 - (num / den).sqrt())
+}
+
+/// Estimates x̂(0) by least squares on the one-step errors.
+///
+/// The one-step predictor is affine in x̂(0) whenever every y is measured (effects use the
+/// measured y and ψ), so this is exact: `ŷ(t) = ŷ₀(t) + C (A−KC)ᵗ x̂(0)`. Samples with a
+/// missing y are left out of the fit.
+pub fn estimate_x0(model: &Model, rec: &Record) -> Vec<f64> {
+    let n = model.n;
+    let base = one_step(model, rec, &vec![0.0; n]);
+    let p = model.predictor_matrix();
+    // rows: C (A−KC)^t, computed as row recursion r_{t+1} = r_t (A−KC)
+    let mut row = nalgebra::DVector::<f64>::zeros(n).transpose();
+    row[0] = 1.0;
+    let mut ata = nalgebra::DMatrix::<f64>::zeros(n, n);
+    let mut atb = nalgebra::DVector::<f64>::zeros(n);
+    for t in 0..rec.len() {
+        if rec.y[t].is_finite() && base[t].is_finite() {
+            let r = row.transpose();
+            ata += &r * r.transpose();
+            atb += &r * (rec.y[t] - base[t]);
+        }
+        row = &row * &p;
+        if row.amax() < 1e-14 {
+            break;
+        }
+    }
+    let ridge = 1e-9 * (ata.trace() / n as f64).max(1e-12);
+    for i in 0..n {
+        ata[(i, i)] += ridge;
+    }
+    match ata.cholesky() {
+        Some(c) => c.solve(&atb).iter().copied().collect(),
+        None => vec![0.0; n],
+    }
+}
+
+/// Fit % of `model` on `rec` at horizon `h`, with x̂(0) estimated from the record.
+pub fn fit_at(model: &Model, rec: &Record, h: Horizon) -> f64 {
+    let x0 = estimate_x0(model, rec);
+    fit(&rec.y, &predict(model, rec, &x0, h))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::Effect;
+
+    fn m4() -> Model {
+        Model::new(
+            1.0,
+            vec![-0.2, 0.3, -0.1, 0.6],
+            vec![0.01, 0.03, 0.05, 0.02],
+            vec![0.8, 0.5, 0.3, 0.2],
+        )
+        .unwrap()
+    }
+
+    fn rec(n: usize) -> Record {
+        let u: Vec<f64> = (0..n)
+            .map(|i| if (i / 13) % 2 == 0 { 10.0 } else { -7.0 })
+            .collect();
+        let y: Vec<f64> = (0..n).map(|i| (i as f64 * 0.1).sin()).collect();
+        let mut r = Record::from_uy("t", 1.0, u, y);
+        r.psi = Some((0..n).map(|i| i as f64 * 3.0).collect());
+        r
+    }
+
+    #[test]
+    fn k1_equals_one_step_and_ksteps_start_as_simulation() {
+        let m = m4();
+        let r = rec(200);
+        let x0 = [0.1, -0.2, 0.0, 0.3];
+        assert_eq!(k_step(&m, &r, &x0, 1), one_step(&m, &r, &x0));
+        let k5 = k_step(&m, &r, &x0, 5);
+        let sim = simulate(&m, &r, &x0);
+        assert_eq!(&k5[..5], &sim[..5]);
+        assert_ne!(k5[50], sim[50]);
+    }
+
+    #[test]
+    fn k_step_matches_manual_open_loop() {
+        let m = m4().with_effect(Effect::NonlinearDamping {
+            beta: -0.01,
+            cubic: false,
+        });
+        let r = rec(60);
+        let x0 = [0.0; 4];
+        let k = 7;
+        let pred = k_step(&m, &r, &x0, k);
+        let s = Stepper::new(&m);
+        let t = 40;
+        let mut st = s.initial(&x0, 0.0);
+        for j in 0..=(t - k) {
+            s.step(&mut st, r.u[j], r.y[j], r.psi.as_ref().map(|p| p[j]));
+        }
+        for j in (t - k + 1)..t {
+            s.step(&mut st, r.u[j], f64::NAN, None);
+        }
+        assert_eq!(pred[t], s.output(&st));
+    }
+
+    #[test]
+    fn actuator_chain_order() {
+        let m = m4()
+            .with_effect(Effect::DeadTime { samples: 2 })
+            .with_effect(Effect::Saturation { limit: 5.0 })
+            .with_effect(Effect::RateLimit { rate: 2.0 });
+        let s = Stepper::new(&m);
+        let mut st = s.initial(&[0.0; 4], 0.0);
+        let outs: Vec<f64> = [10.0, 10.0, 10.0, 10.0, 10.0, -10.0]
+            .iter()
+            .map(|u| s.actuator(&mut st, *u))
+            .collect();
+        assert_eq!(outs, vec![0.0, 0.0, 2.0, 4.0, 5.0, 5.0]);
+    }
+
+    #[test]
+    fn x0_estimate_recovers_initial_state() {
+        let m = m4();
+        let mut r = rec(300);
+        let x0 = [0.5, -0.3, 0.2, 0.1];
+        // data generated by the model's own simulation from x0 with no noise
+        r.y = simulate(&m, &r, &x0);
+        let est = estimate_x0(&m, &r);
+        for i in 0..4 {
+            assert!((est[i] - x0[i]).abs() < 1e-8, "{est:?}");
+        }
+        assert!(fit_at(&m, &r, Horizon::Steps(10)) > 99.999);
+    }
+
+    #[test]
+    fn heading_effects_use_measured_heading() {
+        let m = m4().with_effect(Effect::Current {
+            beta_s: 1.0,
+            beta_c: 0.0,
+        });
+        let s = Stepper::new(&m);
+        let mut st = s.initial(&[0.0; 4], 0.0);
+        let o = s.step(&mut st, 0.0, 0.0, Some(90.0));
+        assert!((o.v - 1.0).abs() < 1e-15);
+        assert_eq!(st.psi, 90.0);
+    }
+}
