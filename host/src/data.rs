@@ -77,7 +77,9 @@ pub enum DataError {
         value: String,
     },
     /// Time does not advance uniformly.
-    #[error("{path}: row {row}: time step {step} s breaks uniform sampling (expected {expected} s)")]
+    #[error(
+        "{path}: row {row}: time step {step} s breaks uniform sampling (expected {expected} s)"
+    )]
     NonUniform {
         /// File concerned.
         path: PathBuf,
@@ -424,9 +426,16 @@ mod tests {
 
     #[test]
     fn bad_cell_names_row_and_column() {
-        let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,x,0\n").unwrap_err().to_string();
-        assert!(e.contains("row 2") && e.contains("delta_deg") && e.contains("`x`"), "{e}");
-        let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,1,NaN\n").unwrap_err().to_string();
+        let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,x,0\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("row 2") && e.contains("delta_deg") && e.contains("`x`"),
+            "{e}"
+        );
+        let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,1,NaN\n")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("r_degps") && e.contains("NaN"), "{e}");
     }
 
@@ -454,7 +463,13 @@ mod tests {
         assert_eq!(back.ts, 0.25);
         let leftovers: Vec<_> = std::fs::read_dir(&dir)
             .unwrap()
-            .filter(|e| e.as_ref().unwrap().file_name().to_string_lossy().contains(".tmp"))
+            .filter(|e| {
+                e.as_ref()
+                    .unwrap()
+                    .file_name()
+                    .to_string_lossy()
+                    .contains(".tmp")
+            })
             .collect();
         assert!(leftovers.is_empty());
         std::fs::remove_dir_all(&dir).unwrap();
