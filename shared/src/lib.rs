@@ -5,4 +5,13 @@
 #![no_std]
 #![deny(missing_docs)]
 
+#[cfg(test)]
+extern crate std;
+
+pub mod blob;
+pub mod crc;
 pub mod model;
+pub mod wire;
+
+#[cfg(test)]
+mod tests;

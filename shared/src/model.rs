@@ -270,3 +270,486 @@ pub struct ModelSpec {
     /// Effects, at most one of each kind.
     pub effects: Vec<Effect, MAX_EFFECTS>,
 }
+
+/// Largest absolute value accepted for any model coefficient or effect parameter.
+pub const MAX_MAGNITUDE: f32 = 1.0e6;
+/// Largest sample time accepted, in seconds.
+pub const MAX_SAMPLE_TIME: f32 = 3600.0;
+
+/// Which coefficient vector of the model an error refers to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Field {
+    /// The companion row `a`.
+    A,
+    /// The input vector `b`.
+    B,
+    /// The Kalman gain `k`.
+    K,
+}
+
+impl Field {
+    /// The field's name as written in the model (`"a"`, `"b"`, `"k"`).
+    ///
+    /// ```
+    /// use yawcast_shared::model::Field;
+    /// assert_eq!(Field::K.name(), "k");
+    /// ```
+    pub const fn name(self) -> &'static str {
+        match self {
+            Field::A => "a",
+            Field::B => "b",
+            Field::K => "k",
+        }
+    }
+}
+
+/// Why a [`ModelSpec`] was refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum ModelError {
+    /// The order is outside `MIN_ORDER..=MAX_ORDER`.
+    Order(u8),
+    /// A coefficient vector does not hold exactly `order` values.
+    Length {
+        /// The vector.
+        field: Field,
+        /// Its length.
+        len: usize,
+    },
+    /// A coefficient is NaN, infinite or larger than [`MAX_MAGNITUDE`] in magnitude.
+    Coefficient {
+        /// The vector.
+        field: Field,
+        /// Zero-based index of the offending value.
+        index: usize,
+    },
+    /// The sample time is not in `(0, MAX_SAMPLE_TIME]`.
+    SampleTime,
+    /// An effect parameter is out of its range (non-finite, too large, or violating the
+    /// effect's own constraint such as a positive rate).
+    EffectParameter(EffectKind),
+    /// The same effect kind appears twice.
+    DuplicateEffect(EffectKind),
+    /// The companion matrix A has an eigenvalue on or outside the unit circle.
+    UnstableModel,
+    /// The predictor matrix A − K C has an eigenvalue on or outside the unit circle.
+    UnstablePredictor,
+}
+
+impl core::fmt::Display for ModelError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            ModelError::Order(n) => {
+                write!(f, "model order {n} is outside {MIN_ORDER}..={MAX_ORDER}")
+            }
+            ModelError::Length { field, len } => write!(
+                f,
+                "vector {} holds {len} values, not one per state",
+                field.name()
+            ),
+            ModelError::Coefficient { field, index } => write!(
+                f,
+                "{}[{index}] is not finite or exceeds {MAX_MAGNITUDE:e} in magnitude",
+                field.name()
+            ),
+            ModelError::SampleTime => {
+                write!(f, "sample time must be in (0, {MAX_SAMPLE_TIME}] seconds")
+            }
+            ModelError::EffectParameter(kind) => {
+                write!(f, "effect {} has a parameter out of range", kind.name())
+            }
+            ModelError::DuplicateEffect(kind) => {
+                write!(f, "effect {} appears more than once", kind.name())
+            }
+            ModelError::UnstableModel => {
+                write!(f, "A has an eigenvalue on or outside the unit circle")
+            }
+            ModelError::UnstablePredictor => write!(
+                f,
+                "the predictor A - K C has an eigenvalue on or outside the unit circle"
+            ),
+        }
+    }
+}
+
+impl core::error::Error for ModelError {}
+
+impl ModelSpec {
+    /// Builds a model and validates it (see [`ModelSpec::validate`]).
+    ///
+    /// # Errors
+    /// [`ModelError::Length`] when a slice is longer than [`MAX_ORDER`] or does not match
+    /// `order`, [`ModelError::DuplicateEffect`] when more than one effect of a kind is given,
+    /// and every error of [`ModelSpec::validate`].
+    ///
+    /// ```
+    /// use yawcast_shared::model::{Effect, ModelError, ModelSpec, Units};
+    /// let m = ModelSpec::new(
+    ///     2, 1.0, &[-0.2, 0.5], &[0.1, 0.05], &[0.3, 0.1], Units::default(),
+    ///     &[Effect::Bias { beta: 0.01 }],
+    /// )?;
+    /// assert_eq!(m.order, 2);
+    /// assert_eq!(m.effects.len(), 1);
+    /// // a = (0, 1.5): z² − 1.5 z has the root 1.5, outside the unit circle.
+    /// let bad = ModelSpec::new(2, 1.0, &[0.0, 1.5], &[0.1, 0.0], &[0.0, 0.0],
+    ///                          Units::default(), &[]);
+    /// assert_eq!(bad, Err(ModelError::UnstableModel));
+    /// # Ok::<(), ModelError>(())
+    /// ```
+    pub fn new(
+        order: u8,
+        ts: f32,
+        a: &[f32],
+        b: &[f32],
+        k: &[f32],
+        units: Units,
+        effects: &[Effect],
+    ) -> Result<Self, ModelError> {
+        let vec = |field: Field, v: &[f32]| -> Result<Vec<f32, MAX_ORDER>, ModelError> {
+            Vec::from_slice(v).map_err(|_| ModelError::Length {
+                field,
+                len: v.len(),
+            })
+        };
+        let mut list = Vec::new();
+        for e in effects {
+            if list.push(*e).is_err() {
+                return Err(ModelError::DuplicateEffect(e.kind()));
+            }
+        }
+        let spec = ModelSpec {
+            order,
+            ts,
+            a: vec(Field::A, a)?,
+            b: vec(Field::B, b)?,
+            k: vec(Field::K, k)?,
+            units,
+            effects: list,
+        };
+        spec.validate()?;
+        Ok(spec)
+    }
+
+    /// Checks everything the firmware relies on.
+    ///
+    /// The order is in `MIN_ORDER..=MAX_ORDER`; `a`, `b`, `k` hold `order` finite values of
+    /// magnitude at most [`MAX_MAGNITUDE`]; `0 < ts ≤ MAX_SAMPLE_TIME`; every effect's
+    /// parameters are finite and at most [`MAX_MAGNITUDE`] in magnitude, dead time is in
+    /// `1..=MAX_DEAD_TIME`, rate and limit are positive; no effect kind appears twice; and
+    /// both A and the predictor A − K C have all eigenvalues strictly inside the unit circle
+    /// (Schur–Cohn test on their characteristic polynomials, in `f64`).
+    ///
+    /// # Errors
+    /// The first [`ModelError`] found, in the order listed above.
+    ///
+    /// ```
+    /// use yawcast_shared::model::{ModelError, ModelSpec, Units};
+    /// let mut m = ModelSpec::new(2, 0.5, &[-0.2, 0.5], &[0.1, 0.05], &[0.3, 0.1],
+    ///                            Units::default(), &[])?;
+    /// assert_eq!(m.validate(), Ok(()));
+    /// // A large gain makes A − K C unstable although A is stable.
+    /// m.k[0] = 3.0;
+    /// assert_eq!(m.validate(), Err(ModelError::UnstablePredictor));
+    /// # Ok::<(), ModelError>(())
+    /// ```
+    pub fn validate(&self) -> Result<(), ModelError> {
+        let n = usize::from(self.order);
+        if !(MIN_ORDER..=MAX_ORDER).contains(&n) {
+            return Err(ModelError::Order(self.order));
+        }
+        for (field, v) in [
+            (Field::A, &self.a),
+            (Field::B, &self.b),
+            (Field::K, &self.k),
+        ] {
+            if v.len() != n {
+                return Err(ModelError::Length {
+                    field,
+                    len: v.len(),
+                });
+            }
+            if let Some(index) = v.iter().position(|x| !sane(*x)) {
+                return Err(ModelError::Coefficient { field, index });
+            }
+        }
+        if !(self.ts > 0.0 && self.ts <= MAX_SAMPLE_TIME) {
+            return Err(ModelError::SampleTime);
+        }
+        let mut seen = [false; EffectKind::ALL.len()];
+        for e in &self.effects {
+            let kind = e.kind();
+            let slot = kind as usize;
+            if seen[slot] {
+                return Err(ModelError::DuplicateEffect(kind));
+            }
+            seen[slot] = true;
+            if !effect_ok(e) {
+                return Err(ModelError::EffectParameter(kind));
+            }
+        }
+        let mut poly = [0.0f64; MAX_ORDER + 1];
+        companion_char_poly(&self.a, &[0.0; MAX_ORDER][..n], &mut poly[..=n]);
+        if !schur_stable(&poly[..=n]) {
+            return Err(ModelError::UnstableModel);
+        }
+        companion_char_poly(&self.a, &self.k, &mut poly[..=n]);
+        if !schur_stable(&poly[..=n]) {
+            return Err(ModelError::UnstablePredictor);
+        }
+        Ok(())
+    }
+
+    /// The effect of the given kind, if the model carries one.
+    ///
+    /// ```
+    /// use yawcast_shared::model::{Effect, EffectKind, ModelSpec, Units};
+    /// let m = ModelSpec::new(2, 1.0, &[-0.2, 0.5], &[0.1, 0.05], &[0.3, 0.1],
+    ///                        Units::default(), &[Effect::DeadTime { samples: 2 }]).unwrap();
+    /// assert_eq!(m.effect(EffectKind::DeadTime), Some(Effect::DeadTime { samples: 2 }));
+    /// assert_eq!(m.effect(EffectKind::Wind), None);
+    /// ```
+    pub fn effect(&self, kind: EffectKind) -> Option<Effect> {
+        self.effects.iter().copied().find(|e| e.kind() == kind)
+    }
+}
+
+/// Finite and at most [`MAX_MAGNITUDE`] in magnitude.
+fn sane(x: f32) -> bool {
+    x.is_finite() && (-MAX_MAGNITUDE..=MAX_MAGNITUDE).contains(&x)
+}
+
+fn effect_ok(e: &Effect) -> bool {
+    match *e {
+        Effect::Bias { beta } | Effect::Asymmetry { beta } => sane(beta),
+        Effect::NonlinearDamping { beta, .. } => sane(beta),
+        Effect::GyroBias { d_y } => sane(d_y),
+        Effect::DeadTime { samples } => (1..=MAX_DEAD_TIME).contains(&samples),
+        Effect::RateLimit { rate } => sane(rate) && rate > 0.0,
+        Effect::Saturation { limit } => sane(limit) && limit > 0.0,
+        Effect::Wind {
+            beta_s2,
+            beta_c2,
+            beta_s1,
+            beta_c1,
+        } => sane(beta_s2) && sane(beta_c2) && sane(beta_s1) && sane(beta_c1),
+        Effect::Current { beta_s, beta_c } => sane(beta_s) && sane(beta_c),
+    }
+}
+
+/// Characteristic polynomial of `A − k e₁ᵀ` for the companion matrix with last row `a`,
+/// written monic in descending powers: `out = [1, c_1, …, c_n]` for `z^n + c_1 z^{n−1} + … + c_n`.
+///
+/// From `z x_i = x_{i+1} − k_i x_1` (i < n): `x_i = p_i(z) x_1` with `p_1 = 1`,
+/// `p_{i+1} = z p_i + k_i`; the last row gives `z p_n + k_n − Σ a_j p_j = 0`.
+/// With `k = 0` this is `z^n − a_n z^{n−1} − … − a_1`.
+fn companion_char_poly(a: &[f32], k: &[f32], out: &mut [f64]) {
+    let n = out.len() - 1;
+    // p[i] holds p_{i+1} in ascending powers (p[i][j] = coefficient of z^j).
+    let mut p = [[0.0f64; MAX_ORDER + 1]; MAX_ORDER];
+    p[0][0] = 1.0;
+    for i in 1..n {
+        let (prev, rest) = p.split_at_mut(i);
+        let cur = &mut rest[0];
+        let prev = &prev[i - 1];
+        for j in (1..=i).rev() {
+            cur[j] = prev[j - 1];
+        }
+        cur[0] = f64::from(k[i - 1]);
+    }
+    // q(z) = z p_n + k_n − Σ a_j p_j, ascending powers, degree n.
+    let mut q = [0.0f64; MAX_ORDER + 1];
+    q[1..=n].copy_from_slice(&p[n - 1][..n]);
+    q[0] += f64::from(k[n - 1]);
+    for (aj, pj) in a.iter().zip(p.iter()).take(n) {
+        for m in 0..n {
+            q[m] -= f64::from(*aj) * pj[m];
+        }
+    }
+    for i in 0..=n {
+        out[i] = q[n - i];
+    }
+}
+
+/// Schur–Cohn (Levinson step-down) test: `true` when every root of the monic polynomial
+/// `poly = [1, c_1, …, c_n]` (descending powers) lies strictly inside the unit circle.
+fn schur_stable(poly: &[f64]) -> bool {
+    let n = poly.len() - 1;
+    let mut c = [0.0f64; MAX_ORDER + 1];
+    c[..=n].copy_from_slice(poly);
+    for m in (1..=n).rev() {
+        let r = c[m];
+        if !(r.is_finite() && r < 1.0 && r > -1.0) {
+            return false;
+        }
+        let den = 1.0 - r * r;
+        let mut next = [0.0f64; MAX_ORDER + 1];
+        next[0] = 1.0;
+        for i in 1..m {
+            next[i] = (c[i] - r * c[m - i]) / den;
+        }
+        c = next;
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn poly_of(a: &[f32], k: &[f32]) -> [f64; MAX_ORDER + 1] {
+        let mut out = [0.0; MAX_ORDER + 1];
+        companion_char_poly(a, k, &mut out[..=a.len()]);
+        out
+    }
+
+    #[test]
+    fn char_poly_of_companion() {
+        // z^3 − a3 z^2 − a2 z − a1
+        let p = poly_of(&[0.25, -0.5, 0.75], &[0.0; 3]);
+        assert_eq!(&p[..4], &[1.0, -0.75, 0.5, -0.25]);
+    }
+
+    #[test]
+    fn char_poly_with_gain_matches_determinant() {
+        // n = 2: A − K C = [[−k1, 1], [a1 − k2, a2]],
+        // det(zI − M) = (z + k1)(z − a2) − (a1 − k2) = z² + (k1 − a2) z − k1 a2 − a1 + k2.
+        let (a1, a2, k1, k2) = (0.5f32, 0.25f32, 0.75f32, 0.125f32);
+        let p = poly_of(&[a1, a2], &[k1, k2]);
+        let (a1, a2, k1, k2) = (a1 as f64, a2 as f64, k1 as f64, k2 as f64);
+        assert_eq!(&p[..3], &[1.0, k1 - a2, -k1 * a2 - a1 + k2]);
+    }
+
+    #[test]
+    fn schur_cohn_on_known_roots() {
+        // (z − 0.9)(z + 0.8) = z² − 0.1 z − 0.72: stable.
+        assert!(schur_stable(&[1.0, -0.1, -0.72]));
+        // (z − 1.01)(z − 0.5) = z² − 1.51 z + 0.505: unstable.
+        assert!(!schur_stable(&[1.0, -1.51, 0.505]));
+        // root exactly on the circle: z² − 1 is not strictly stable.
+        assert!(!schur_stable(&[1.0, 0.0, -1.0]));
+        // complex pair 0.95 e^{±i 0.3}: z² − 1.9 cos(0.3) z + 0.9025.
+        assert!(schur_stable(&[1.0, -1.9 * 0.3f64.cos(), 0.9025]));
+        // complex pair of modulus 1.05.
+        assert!(!schur_stable(&[1.0, -2.1 * 0.3f64.cos(), 1.1025]));
+        // (z − 0.5)^4 = z⁴ − 2 z³ + 1.5 z² − 0.5 z + 0.0625.
+        assert!(schur_stable(&[1.0, -2.0, 1.5, -0.5, 0.0625]));
+        assert!(!schur_stable(&[1.0, f64::NAN, 0.0]));
+    }
+
+    fn base() -> ModelSpec {
+        ModelSpec::new(
+            4,
+            0.5,
+            &[-0.1, 0.2, -0.3, 0.6],
+            &[0.01, 0.02, 0.03, 0.04],
+            &[0.1, 0.1, 0.1, 0.1],
+            Units::default(),
+            &[],
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn validate_rejects_each_kind_of_error() {
+        let mut m = base();
+        m.order = 9;
+        assert_eq!(m.validate(), Err(ModelError::Order(9)));
+        let mut m = base();
+        m.b.pop();
+        assert_eq!(
+            m.validate(),
+            Err(ModelError::Length {
+                field: Field::B,
+                len: 3
+            })
+        );
+        let mut m = base();
+        m.k[2] = f32::NAN;
+        assert_eq!(
+            m.validate(),
+            Err(ModelError::Coefficient {
+                field: Field::K,
+                index: 2
+            })
+        );
+        let mut m = base();
+        m.a[0] = 2.0e6;
+        assert!(matches!(m.validate(), Err(ModelError::Coefficient { .. })));
+        for ts in [0.0, -1.0, 3601.0, f32::INFINITY, f32::NAN] {
+            let mut m = base();
+            m.ts = ts;
+            assert_eq!(m.validate(), Err(ModelError::SampleTime), "ts = {ts}");
+        }
+        for e in [
+            Effect::DeadTime { samples: 0 },
+            Effect::DeadTime { samples: 33 },
+            Effect::RateLimit { rate: 0.0 },
+            Effect::Saturation { limit: -1.0 },
+            Effect::Bias { beta: f32::NAN },
+            Effect::Wind {
+                beta_s2: 0.0,
+                beta_c2: f32::INFINITY,
+                beta_s1: 0.0,
+                beta_c1: 0.0,
+            },
+        ] {
+            let mut m = base();
+            m.effects.push(e).unwrap();
+            assert_eq!(m.validate(), Err(ModelError::EffectParameter(e.kind())));
+        }
+        let mut m = base();
+        m.effects.push(Effect::Bias { beta: 0.1 }).unwrap();
+        m.effects.push(Effect::Bias { beta: 0.2 }).unwrap();
+        assert_eq!(
+            m.validate(),
+            Err(ModelError::DuplicateEffect(EffectKind::Bias))
+        );
+        let mut m = base();
+        m.a[3] = 1.2;
+        assert_eq!(m.validate(), Err(ModelError::UnstableModel));
+        let mut m = base();
+        m.k[0] = 2.5;
+        assert_eq!(m.validate(), Err(ModelError::UnstablePredictor));
+        assert_eq!(base().validate(), Ok(()));
+    }
+
+    #[test]
+    fn new_rejects_overlong_inputs() {
+        let nine = [0.0f32; 9];
+        assert_eq!(
+            ModelSpec::new(4, 1.0, &nine, &nine, &nine, Units::default(), &[]),
+            Err(ModelError::Length {
+                field: Field::A,
+                len: 9
+            })
+        );
+        let ten = [Effect::Bias { beta: 0.0 }; 10];
+        let z = [0.0f32; 4];
+        assert_eq!(
+            ModelSpec::new(4, 1.0, &z, &z, &z, Units::default(), &ten),
+            Err(ModelError::DuplicateEffect(EffectKind::Bias))
+        );
+    }
+
+    #[test]
+    fn display_is_specific() {
+        use std::string::ToString;
+        assert_eq!(
+            ModelError::Order(1).to_string(),
+            "model order 1 is outside 2..=8"
+        );
+        assert_eq!(
+            ModelError::DuplicateEffect(EffectKind::Wind).to_string(),
+            "effect wind appears more than once"
+        );
+        assert_eq!(
+            ModelError::Coefficient {
+                field: Field::A,
+                index: 3
+            }
+            .to_string(),
+            "a[3] is not finite or exceeds 1e6 in magnitude"
+        );
+    }
+}
