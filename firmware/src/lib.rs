@@ -1,3 +1,933 @@
 //! yawcast-firmware: the on-board f32 yaw-rate predictor.
+//!
+//! [`Predictor`] runs the model of `yawcast_shared::model` in `f32`: a Kalman-gain
+//! measurement update and time update per sample ([`Predictor::update`]) and a k-step
+//! open-loop prediction ([`Predictor::predict_into`]). It never allocates and never panics;
+//! numerical failure is reported as a status or an error value.
+//!
+//! # Exact semantics
+//!
+//! Bit-exactness between builds (x86_64 and Cortex-M4F) rests on every build executing the
+//! same sequence of IEEE-754 `f32` operations. Rust never contracts `a * b + c` into a fused
+//! multiply-add, this crate never calls `mul_add`, and transcendental functions come from
+//! `libm` (portable software implementations). Each expression below is evaluated exactly as
+//! written, left to right, one rounding per operation. `d_y` is the `gyro-bias` output offset;
+//! where a formula says "`+ d_y`" or "`− d_y`", that operation is performed only when the
+//! model has a `gyro-bias` effect (otherwise the value is used as is).
+//!
+//! State: `x̂ ∈ R^N`, a delay line of the last `d` commands (`d` = dead time, 0 without the
+//! effect), the actuator position `ũ_prev`, the heading `ψ̂` (deg). All start at zero.
+//!
+//! [`Predictor::update_with_heading`]`(u, y, psi)`:
+//! 1. actuator: `δ = u(t−d)` (pop the delay line, push `u`; `δ = u` when `d = 0`);
+//!    `τ = clamp(δ, −limit, limit)` with saturation, else `τ = δ`;
+//!    `ũ = ũ_prev + clamp(τ − ũ_prev, −s, s)` with a rate limit, where `s = rate · ts` is
+//!    computed once when the model is loaded, else `ũ = τ`; then `ũ_prev = ũ`.
+//!    `clamp(x, lo, hi)` is `lo` if `x < lo`, `hi` if `x > hi`, else `x`.
+//! 2. heading: `ψ = psi` when given and finite, else `ψ̂`.
+//! 3. `ŷ = x̂_1 + d_y`; `y_used = y` if `y` is finite, else `ŷ`.
+//! 4. `v = ũ`, then for each effect present, in this order, `v = v + β·φ`:
+//!    bias `v = v + β`; asymmetry `φ = ũ` if `ũ > 0` else `+0`; nonlinear damping
+//!    `φ = y_used · |y_used|` or, cubic, `φ = (y_used · y_used) · y_used`; wind and current use
+//!    `r = ψ · (π/180)` (the constant rounded to `f32`), `(sin r, cos r) = libm::sincosf(r)`,
+//!    `(sin 2r, cos 2r) = libm::sincosf(r + r)`; wind adds `β_s2·sin 2r`, `β_c2·cos 2r`,
+//!    `β_s1·sin r`, `β_c1·cos r`, then current adds `β_s·sin r`, `β_c·cos r`, one term at a time.
+//! 5. `e = y − ŷ` if `y` is finite; otherwise there is no correction
+//!    ([`UpdateStatus::SkippedCorrection`]) and `e = 0`.
+//! 6. `x̂'_i = (x̂_{i+1} + b_i·v) + k_i·e` for `i < N`;
+//!    `x̂'_N = ((…((a_1·x̂_1 + a_2·x̂_2) + a_3·x̂_3) …) + a_N·x̂_N + b_N·v) + k_N·e`.
+//! 7. `ψ̂ = ψ + ts·(y_used − d_y)`.
+//! 8. when `x̂'_1 + … + x̂'_N + ψ̂` (summed left to right) is not finite — a component is
+//!    NaN or infinite, or the sum leaves the `f32` range — the whole state is reset to zero
+//!    and [`UpdateStatus::NonFiniteReset`] is returned.
+//!
+//! [`Predictor::predict_into`]`(out, future_u)` works on a copy of the state:
+//! `out[0] = x̂_1 + d_y`; for `j = 1..H`, one step as above with `u = future_u[j−1]`,
+//! `y_used = out[j−1]`, `ψ = ψ̂` of the copy and no correction term at all
+//! (`x̂'_i = x̂_{i+1} + b_i·v`, `x̂'_N = Σ a_i x̂_i + b_N·v`), then `out[j] = x̂_1 + d_y`.
+//! If any step of the copy goes non-finite the call fails and `out` must not be used.
+//!
+//! A model without effects runs a specialised path (a shift and one dot product, no effect
+//! dispatch) that performs exactly the operations above.
 #![no_std]
 #![deny(missing_docs)]
+// `v = v + β·φ` is written out so the code reads exactly like the documented evaluation order.
+#![allow(clippy::assign_op_pattern)]
+
+use yawcast_shared::model::{Effect, ModelError, ModelSpec, MAX_DEAD_TIME, MAX_ORDER, MIN_ORDER};
+
+/// Longest prediction horizon [`Predictor::predict_into`] accepts.
+pub const MAX_HORIZON: usize = 64;
+
+/// Length of the dead-time delay line (a power of two, so index masking cannot fail).
+const DELAY_LEN: usize = MAX_DEAD_TIME as usize;
+const _: () = assert!(DELAY_LEN.is_power_of_two());
+
+/// Degrees to radians, rounded once to `f32`.
+const DEG2RAD: f32 = core::f32::consts::PI / 180.0;
+
+/// What one [`Predictor::update`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum UpdateStatus {
+    /// The measurement was used: innovation correction applied.
+    Corrected,
+    /// The measurement was missing or non-finite: time update only.
+    SkippedCorrection,
+    /// The new state was not finite; the predictor was reset to the zero state.
+    NonFiniteReset,
+}
+
+/// Why a predictor call failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum PredictorError {
+    /// The model's order is not the predictor's `N`.
+    OrderMismatch {
+        /// The predictor's order `N`.
+        expected: usize,
+        /// The model's order.
+        found: u8,
+    },
+    /// The model does not validate.
+    InvalidModel(ModelError),
+    /// The horizon `out.len()` is not in `1..=MAX_HORIZON`.
+    HorizonOutOfRange(usize),
+    /// Fewer future commands than the horizon needs (`H − 1`).
+    NotEnoughInputs {
+        /// Commands needed.
+        needed: usize,
+        /// Commands given.
+        got: usize,
+    },
+    /// The prediction went non-finite.
+    NonFinite,
+    /// A state given to [`Predictor::restore`] is not finite or not consistent with the model.
+    InvalidState,
+}
+
+impl core::fmt::Display for PredictorError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            PredictorError::OrderMismatch { expected, found } => write!(
+                f,
+                "model order {found} does not match the predictor order {expected}"
+            ),
+            PredictorError::InvalidModel(e) => write!(f, "invalid model: {e}"),
+            PredictorError::HorizonOutOfRange(h) => {
+                write!(f, "horizon {h} is outside 1..={MAX_HORIZON}")
+            }
+            PredictorError::NotEnoughInputs { needed, got } => {
+                write!(f, "prediction needs {needed} future commands, {got} given")
+            }
+            PredictorError::NonFinite => write!(f, "prediction became non-finite"),
+            PredictorError::InvalidState => {
+                write!(f, "state is non-finite or inconsistent with the model")
+            }
+        }
+    }
+}
+
+impl core::error::Error for PredictorError {}
+
+impl From<ModelError> for PredictorError {
+    fn from(e: ModelError) -> Self {
+        PredictorError::InvalidModel(e)
+    }
+}
+
+/// The complete predictor state, for save and restore.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PredictorState<const N: usize> {
+    /// State estimate x̂ (after the last update: x̂(t+1|t)).
+    pub x: [f32; N],
+    /// Dead-time delay line, a ring of the last `d` commands; only `delay[..d]` is used.
+    pub delay: [f32; MAX_DEAD_TIME as usize],
+    /// Index of the oldest command in the ring (`< d`, 0 without dead time).
+    pub delay_head: u8,
+    /// Actuator position ũ_prev.
+    pub u_prev: f32,
+    /// Integrated heading ψ̂ in degrees.
+    pub psi: f32,
+}
+
+impl<const N: usize> PredictorState<N> {
+    /// The all-zero state.
+    const ZERO: Self = Self {
+        x: [0.0; N],
+        delay: [0.0; DELAY_LEN],
+        delay_head: 0,
+        u_prev: 0.0,
+        psi: 0.0,
+    };
+}
+
+/// The f32 k-step yaw-rate predictor for a model of order `N` (4 by default).
+///
+/// See the [crate documentation](crate) for the exact arithmetic.
+#[derive(Debug, Clone)]
+pub struct Predictor<const N: usize = 4> {
+    a: [f32; N],
+    b: [f32; N],
+    k: [f32; N],
+    ts: f32,
+    /// No effect at all: the specialised path.
+    plain: bool,
+    dy: Option<f32>,
+    dead: u8,
+    limit: Option<f32>,
+    rate_step: Option<f32>,
+    bias: Option<f32>,
+    asym: Option<f32>,
+    damp: Option<(f32, bool)>,
+    wind: Option<[f32; 4]>,
+    current: Option<[f32; 2]>,
+    st: PredictorState<N>,
+}
+
+/// `lo` if `x < lo`, `hi` if `x > hi`, else `x` (NaN passes through). Never panics.
+#[inline(always)]
+fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
+    if x < lo {
+        lo
+    } else if x > hi {
+        hi
+    } else {
+        x
+    }
+}
+
+impl<const N: usize> Predictor<N> {
+    /// Compile-time check of `N`: instantiating a predictor of an unsupported order fails to build.
+    const ORDER_OK: () = assert!(
+        N >= MIN_ORDER && N <= MAX_ORDER,
+        "Predictor order N must be in MIN_ORDER..=MAX_ORDER"
+    );
+
+    /// Builds a predictor for `spec`, in the zero state.
+    ///
+    /// # Errors
+    /// [`PredictorError::OrderMismatch`] when `spec.order != N`,
+    /// [`PredictorError::InvalidModel`] when the model does not validate.
+    ///
+    /// ```
+    /// use yawcast_firmware::{Predictor, PredictorError};
+    /// use yawcast_shared::model::{ModelSpec, Units};
+    /// let m = ModelSpec::new(2, 1.0, &[-0.2, 0.5], &[0.1, 0.05], &[0.3, 0.1],
+    ///                        Units::default(), &[]).unwrap();
+    /// let p = Predictor::<2>::new(&m).unwrap();
+    /// assert_eq!(p.prediction(), 0.0);
+    /// assert_eq!(Predictor::<4>::new(&m).unwrap_err(),
+    ///            PredictorError::OrderMismatch { expected: 4, found: 2 });
+    /// ```
+    pub fn new(spec: &ModelSpec) -> Result<Self, PredictorError> {
+        let () = Self::ORDER_OK;
+        if usize::from(spec.order) != N {
+            return Err(PredictorError::OrderMismatch {
+                expected: N,
+                found: spec.order,
+            });
+        }
+        spec.validate()?;
+        let mut p = Predictor {
+            a: [0.0; N],
+            b: [0.0; N],
+            k: [0.0; N],
+            ts: spec.ts,
+            plain: spec.effects.is_empty(),
+            dy: None,
+            dead: 0,
+            limit: None,
+            rate_step: None,
+            bias: None,
+            asym: None,
+            damp: None,
+            wind: None,
+            current: None,
+            st: PredictorState::ZERO,
+        };
+        p.a.copy_from_slice(&spec.a[..N]);
+        p.b.copy_from_slice(&spec.b[..N]);
+        p.k.copy_from_slice(&spec.k[..N]);
+        for e in &spec.effects {
+            match *e {
+                Effect::Bias { beta } => p.bias = Some(beta),
+                Effect::GyroBias { d_y } => p.dy = Some(d_y),
+                Effect::DeadTime { samples } => p.dead = samples,
+                Effect::RateLimit { rate } => p.rate_step = Some(rate * spec.ts),
+                Effect::Saturation { limit } => p.limit = Some(limit),
+                Effect::Asymmetry { beta } => p.asym = Some(beta),
+                Effect::NonlinearDamping { beta, cubic } => p.damp = Some((beta, cubic)),
+                Effect::Wind {
+                    beta_s2,
+                    beta_c2,
+                    beta_s1,
+                    beta_c1,
+                } => p.wind = Some([beta_s2, beta_c2, beta_s1, beta_c1]),
+                Effect::Current { beta_s, beta_c } => p.current = Some([beta_s, beta_c]),
+                // A kind this firmware does not know: refuse rather than ignore it.
+                #[allow(unreachable_patterns)]
+                _ => {
+                    return Err(PredictorError::InvalidModel(ModelError::EffectParameter(
+                        e.kind(),
+                    )))
+                }
+            }
+        }
+        Ok(p)
+    }
+
+    /// One measurement update with command `u` and measured output `y` (NaN when missing),
+    /// without a measured heading. Same as `update_with_heading(u, y, None)`.
+    ///
+    /// # Errors
+    /// None: numerical failure resets the state and is reported as
+    /// [`UpdateStatus::NonFiniteReset`].
+    ///
+    /// ```
+    /// use yawcast_firmware::{Predictor, UpdateStatus};
+    /// use yawcast_shared::model::{ModelSpec, Units};
+    /// let m = ModelSpec::new(2, 1.0, &[-0.25, 0.5], &[0.5, 0.25], &[0.5, 0.125],
+    ///                        Units::default(), &[]).unwrap();
+    /// let mut p = Predictor::<2>::new(&m).unwrap();
+    /// assert_eq!(p.update(1.0, 2.0), UpdateStatus::Corrected);
+    /// // x̂ = (0 + 0.5·1 + 0.5·2, 0 + 0.25·1 + 0.125·2) = (1.5, 0.5)
+    /// assert_eq!(p.state().x, [1.5, 0.5]);
+    /// assert_eq!(p.update(0.0, f32::NAN), UpdateStatus::SkippedCorrection);
+    /// assert_eq!(p.update(f32::INFINITY, 0.0), UpdateStatus::NonFiniteReset);
+    /// assert_eq!(p.state().x, [0.0, 0.0]);
+    /// ```
+    #[inline]
+    pub fn update(&mut self, u: f32, y: f32) -> UpdateStatus {
+        self.update_with_heading(u, y, None)
+    }
+
+    /// One measurement update with command `u`, measured output `y` (NaN when missing) and,
+    /// when logged, the measured heading `psi` in degrees.
+    ///
+    /// # Errors
+    /// None: numerical failure resets the state and is reported as
+    /// [`UpdateStatus::NonFiniteReset`].
+    ///
+    /// ```
+    /// use yawcast_firmware::{Predictor, UpdateStatus};
+    /// use yawcast_shared::model::{Effect, ModelSpec, Units};
+    /// let m = ModelSpec::new(2, 0.5, &[-0.25, 0.5], &[0.5, 0.25], &[0.5, 0.125],
+    ///                        Units::default(),
+    ///                        &[Effect::Current { beta_s: 1.0, beta_c: 0.0 }]).unwrap();
+    /// let mut p = Predictor::<2>::new(&m).unwrap();
+    /// p.update_with_heading(0.0, 2.0, Some(90.0));
+    /// // ψ̂ = 90 + 0.5·2; v = 0 + 1·sin(90°) = 1
+    /// assert_eq!(p.state().psi, 91.0);
+    /// assert_eq!(p.state().x, [0.5 + 0.5 * 2.0, 0.25 + 0.125 * 2.0]);
+    /// ```
+    pub fn update_with_heading(&mut self, u: f32, y: f32, psi: Option<f32>) -> UpdateStatus {
+        let finite = y.is_finite();
+        if self.plain {
+            self.update_plain(u, y, finite, psi)
+        } else {
+            self.update_general(u, y, finite, psi)
+        }
+        let mut sum = self.st.x[0];
+        for xi in &self.st.x[1..] {
+            sum = sum + *xi;
+        }
+        sum = sum + self.st.psi;
+        if !sum.is_finite() {
+            self.st = PredictorState::ZERO;
+            UpdateStatus::NonFiniteReset
+        } else if finite {
+            UpdateStatus::Corrected
+        } else {
+            UpdateStatus::SkippedCorrection
+        }
+    }
+
+    /// The effect-free update: shift, one dot product, heading integration.
+    #[inline(always)]
+    fn update_plain(&mut self, u: f32, y: f32, finite: bool, psi: Option<f32>) {
+        let st = &mut self.st;
+        let yhat = st.x[0];
+        let (y_used, e) = if finite { (y, y - yhat) } else { (yhat, 0.0) };
+        st.u_prev = u;
+        let x = st.x;
+        let mut last = self.a[0] * x[0];
+        for i in 1..N {
+            last = last + self.a[i] * x[i];
+        }
+        for i in 0..N - 1 {
+            st.x[i] = x[i + 1] + self.b[i] * u + self.k[i] * e;
+        }
+        st.x[N - 1] = last + self.b[N - 1] * u + self.k[N - 1] * e;
+        let heading = match psi {
+            Some(p) if p.is_finite() => p,
+            _ => st.psi,
+        };
+        st.psi = heading + self.ts * y_used;
+    }
+
+    #[inline(never)]
+    fn update_general(&mut self, u: f32, y: f32, finite: bool, psi: Option<f32>) {
+        let mut st = self.st;
+        let yhat = self.output(&st);
+        let (y_used, e) = if finite { (y, y - yhat) } else { (yhat, 0.0) };
+        let heading = match psi {
+            Some(p) if p.is_finite() => p,
+            _ => st.psi,
+        };
+        let ut = self.actuator(&mut st, u);
+        let v = self.effective_input(ut, y_used, heading);
+        let x = st.x;
+        let mut last = self.a[0] * x[0];
+        for i in 1..N {
+            last = last + self.a[i] * x[i];
+        }
+        for i in 0..N - 1 {
+            st.x[i] = x[i + 1] + self.b[i] * v + self.k[i] * e;
+        }
+        st.x[N - 1] = last + self.b[N - 1] * v + self.k[N - 1] * e;
+        st.psi = heading + self.ts * self.minus_dy(y_used);
+        self.st = st;
+    }
+
+    /// `x̂_1 + d_y` of a state (`x̂_1` without gyro bias).
+    #[inline(always)]
+    fn output(&self, st: &PredictorState<N>) -> f32 {
+        match self.dy {
+            Some(dy) => st.x[0] + dy,
+            None => st.x[0],
+        }
+    }
+
+    /// `y − d_y` (`y` without gyro bias).
+    #[inline(always)]
+    fn minus_dy(&self, y: f32) -> f32 {
+        match self.dy {
+            Some(dy) => y - dy,
+            None => y,
+        }
+    }
+
+    /// The actuator chain: dead time, saturation, rate limit. Advances its state.
+    #[inline(always)]
+    fn actuator(&self, st: &mut PredictorState<N>, u: f32) -> f32 {
+        let delayed = if self.dead > 0 {
+            let h = usize::from(st.delay_head) % DELAY_LEN;
+            let out = st.delay[h];
+            st.delay[h] = u;
+            let next = st.delay_head + 1;
+            st.delay_head = if next >= self.dead { 0 } else { next };
+            out
+        } else {
+            u
+        };
+        let target = match self.limit {
+            Some(l) => clamp(delayed, -l, l),
+            None => delayed,
+        };
+        let ut = match self.rate_step {
+            Some(s) => st.u_prev + clamp(target - st.u_prev, -s, s),
+            None => target,
+        };
+        st.u_prev = ut;
+        ut
+    }
+
+    /// `v = ũ + Σ β φ`, accumulated one term at a time in library order.
+    #[inline(always)]
+    fn effective_input(&self, ut: f32, y_used: f32, psi: f32) -> f32 {
+        let mut v = ut;
+        if let Some(beta) = self.bias {
+            v = v + beta;
+        }
+        if let Some(beta) = self.asym {
+            let phi = if ut > 0.0 { ut } else { 0.0 };
+            v = v + beta * phi;
+        }
+        if let Some((beta, cubic)) = self.damp {
+            let phi = if cubic {
+                y_used * y_used * y_used
+            } else {
+                y_used * libm::fabsf(y_used)
+            };
+            v = v + beta * phi;
+        }
+        if self.wind.is_some() || self.current.is_some() {
+            let r = psi * DEG2RAD;
+            let (s1, c1) = libm::sincosf(r);
+            if let Some(w) = self.wind {
+                let (s2, c2) = libm::sincosf(r + r);
+                v = v + w[0] * s2;
+                v = v + w[1] * c2;
+                v = v + w[2] * s1;
+                v = v + w[3] * c1;
+            }
+            if let Some(c) = self.current {
+                v = v + c[0] * s1;
+                v = v + c[1] * c1;
+            }
+        }
+        v
+    }
+
+    /// Predicts `out.len()` = H outputs ŷ(t+1|t) … ŷ(t+H|t) from the current state, with
+    /// future commands `future_u` = u(t+1) … u(t+H−1) (extra values are ignored).
+    /// The predictor state is not changed.
+    ///
+    /// # Errors
+    /// [`PredictorError::HorizonOutOfRange`] when H is 0 or above [`MAX_HORIZON`],
+    /// [`PredictorError::NotEnoughInputs`] when `future_u` has fewer than H − 1 values,
+    /// [`PredictorError::NonFinite`] when the prediction overflows or a command is not finite.
+    ///
+    /// ```
+    /// use yawcast_firmware::{Predictor, PredictorError};
+    /// use yawcast_shared::model::{ModelSpec, Units};
+    /// let m = ModelSpec::new(2, 1.0, &[-0.25, 0.5], &[0.5, 0.25], &[0.5, 0.125],
+    ///                        Units::default(), &[]).unwrap();
+    /// let mut p = Predictor::<2>::new(&m).unwrap();
+    /// p.update(1.0, 2.0); // x̂ = (1.5, 0.5)
+    /// let mut out = [0.0f32; 3];
+    /// p.predict_into(&mut out, &[2.0, 0.0])?;
+    /// // x̂' = (0.5 + 0.5·2, −0.25·1.5 + 0.5·0.5 + 0.25·2) = (1.5, 0.375); then x̂'_1 = 0.375
+    /// assert_eq!(out, [1.5, 1.5, 0.375]);
+    /// assert_eq!(p.predict_into(&mut out, &[2.0]),
+    ///            Err(PredictorError::NotEnoughInputs { needed: 2, got: 1 }));
+    /// # Ok::<(), PredictorError>(())
+    /// ```
+    pub fn predict_into(&self, out: &mut [f32], future_u: &[f32]) -> Result<(), PredictorError> {
+        let h = out.len();
+        if h == 0 || h > MAX_HORIZON {
+            return Err(PredictorError::HorizonOutOfRange(h));
+        }
+        if future_u.len() < h - 1 {
+            return Err(PredictorError::NotEnoughInputs {
+                needed: h - 1,
+                got: future_u.len(),
+            });
+        }
+        let ok = if self.plain {
+            self.predict_plain(out, future_u)
+        } else {
+            self.predict_general(out, future_u)
+        };
+        if ok {
+            Ok(())
+        } else {
+            Err(PredictorError::NonFinite)
+        }
+    }
+
+    /// Effect-free prediction. A non-finite value, once in x̂, stays in x̂_N for every later
+    /// step (`a_1·x̂_1` and `b_N·v` always enter it, and `0·∞` is NaN), so checking x̂_N at the
+    /// end covers every step.
+    #[inline(always)]
+    fn predict_plain(&self, out: &mut [f32], future_u: &[f32]) -> bool {
+        let mut x = self.st.x;
+        let (first, rest) = match out.split_first_mut() {
+            Some(s) => s,
+            None => return false,
+        };
+        *first = x[0];
+        for (o, &u) in rest.iter_mut().zip(future_u) {
+            let mut last = self.a[0] * x[0];
+            for i in 1..N {
+                last = last + self.a[i] * x[i];
+            }
+            for i in 0..N - 1 {
+                x[i] = x[i + 1] + self.b[i] * u;
+            }
+            x[N - 1] = last + self.b[N - 1] * u;
+            *o = x[0];
+        }
+        x[N - 1].is_finite()
+    }
+
+    #[inline(never)]
+    fn predict_general(&self, out: &mut [f32], future_u: &[f32]) -> bool {
+        let mut st = self.st;
+        let mut prev = self.output(&st);
+        let mut finite = prev.is_finite();
+        let (first, rest) = match out.split_first_mut() {
+            Some(s) => s,
+            None => return false,
+        };
+        *first = prev;
+        for (o, &u) in rest.iter_mut().zip(future_u) {
+            let y_used = prev;
+            let heading = st.psi;
+            let ut = self.actuator(&mut st, u);
+            let v = self.effective_input(ut, y_used, heading);
+            let x = st.x;
+            let mut last = self.a[0] * x[0];
+            for i in 1..N {
+                last = last + self.a[i] * x[i];
+            }
+            for i in 0..N - 1 {
+                st.x[i] = x[i + 1] + self.b[i] * v;
+            }
+            st.x[N - 1] = last + self.b[N - 1] * v;
+            st.psi = heading + self.ts * self.minus_dy(y_used);
+            prev = self.output(&st);
+            *o = prev;
+            // outputs can overflow through d_y alone, so each one is checked here
+            finite &= prev.is_finite();
+        }
+        finite && st.x[N - 1].is_finite() && st.psi.is_finite()
+    }
+
+    /// The one-step prediction ŷ(t+1|t) = x̂_1 + d_y of the current state.
+    ///
+    /// # Errors
+    /// None.
+    ///
+    /// ```
+    /// use yawcast_firmware::Predictor;
+    /// use yawcast_shared::model::{Effect, ModelSpec, Units};
+    /// let m = ModelSpec::new(2, 1.0, &[-0.25, 0.5], &[0.5, 0.25], &[0.5, 0.125],
+    ///                        Units::default(), &[Effect::GyroBias { d_y: 0.25 }]).unwrap();
+    /// let p = Predictor::<2>::new(&m).unwrap();
+    /// assert_eq!(p.prediction(), 0.25);
+    /// ```
+    pub fn prediction(&self) -> f32 {
+        self.output(&self.st)
+    }
+
+    /// A copy of the full state: x̂, delay line, actuator position, heading.
+    ///
+    /// # Errors
+    /// None.
+    ///
+    /// ```
+    /// use yawcast_firmware::Predictor;
+    /// use yawcast_shared::model::{Effect, ModelSpec, Units};
+    /// let m = ModelSpec::new(2, 1.0, &[-0.25, 0.5], &[0.5, 0.25], &[0.5, 0.125],
+    ///                        Units::default(), &[Effect::DeadTime { samples: 2 }]).unwrap();
+    /// let mut p = Predictor::<2>::new(&m).unwrap();
+    /// p.update(3.0, 0.0);
+    /// let s = p.state();
+    /// assert_eq!(s.delay[0], 3.0);
+    /// assert_eq!(s.delay_head, 1);
+    /// assert_eq!(s.u_prev, 0.0); // u(t−2) = 0
+    /// ```
+    pub fn state(&self) -> PredictorState<N> {
+        self.st
+    }
+
+    /// Replaces the state with a saved one (from [`Predictor::state`]).
+    ///
+    /// # Errors
+    /// [`PredictorError::InvalidState`] when a value used by this model is not finite or
+    /// `delay_head` is not below the dead time (0 without dead time); the state is then
+    /// left unchanged.
+    ///
+    /// ```
+    /// use yawcast_firmware::{Predictor, PredictorError};
+    /// use yawcast_shared::model::{ModelSpec, Units};
+    /// let m = ModelSpec::new(2, 1.0, &[-0.25, 0.5], &[0.5, 0.25], &[0.5, 0.125],
+    ///                        Units::default(), &[]).unwrap();
+    /// let mut p = Predictor::<2>::new(&m).unwrap();
+    /// p.update(1.0, 2.0);
+    /// let saved = p.state();
+    /// p.update(5.0, -1.0);
+    /// p.restore(saved)?;
+    /// assert_eq!(p.state().x, [1.5, 0.5]);
+    /// let mut bad = saved;
+    /// bad.x[1] = f32::NAN;
+    /// assert_eq!(p.restore(bad), Err(PredictorError::InvalidState));
+    /// # Ok::<(), PredictorError>(())
+    /// ```
+    pub fn restore(&mut self, state: PredictorState<N>) -> Result<(), PredictorError> {
+        let d = usize::from(self.dead);
+        let head_ok = if d == 0 {
+            state.delay_head == 0
+        } else {
+            state.delay_head < self.dead
+        };
+        let finite = state.x.iter().all(|v| v.is_finite())
+            && state.delay.iter().take(d).all(|v| v.is_finite())
+            && state.u_prev.is_finite()
+            && state.psi.is_finite();
+        if head_ok && finite {
+            self.st = state;
+            Ok(())
+        } else {
+            Err(PredictorError::InvalidState)
+        }
+    }
+
+    /// Resets the state to zero (x̂, delay line, actuator position, heading).
+    ///
+    /// # Errors
+    /// None.
+    ///
+    /// ```
+    /// use yawcast_firmware::Predictor;
+    /// use yawcast_shared::model::{ModelSpec, Units};
+    /// let m = ModelSpec::new(2, 1.0, &[-0.25, 0.5], &[0.5, 0.25], &[0.5, 0.125],
+    ///                        Units::default(), &[]).unwrap();
+    /// let mut p = Predictor::<2>::new(&m).unwrap();
+    /// p.update(1.0, 2.0);
+    /// p.reset();
+    /// assert_eq!(p.state().x, [0.0, 0.0]);
+    /// assert_eq!(p.state().psi, 0.0);
+    /// ```
+    pub fn reset(&mut self) {
+        self.st = PredictorState::ZERO;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use yawcast_shared::model::Units;
+
+    const A: [f32; 4] = [-0.1, 0.2, -0.3, 0.6];
+    const B: [f32; 4] = [0.01, 0.02, 0.03, 0.04];
+    const K: [f32; 4] = [0.3, 0.2, 0.1, 0.05];
+
+    fn model(effects: &[Effect]) -> ModelSpec {
+        ModelSpec::new(4, 0.5, &A, &B, &K, Units::default(), effects).unwrap()
+    }
+
+    /// Deterministic pseudo-random inputs: (u, y, psi).
+    fn inputs(n: usize) -> std::vec::Vec<(f32, f32, Option<f32>)> {
+        let mut s = 0x1234_5678_9abc_def0u64;
+        let mut next = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32 - 0.5
+        };
+        (0..n)
+            .map(|i| {
+                let y = if i % 17 == 5 { f32::NAN } else { 4.0 * next() };
+                let psi = if i % 3 == 0 {
+                    Some(720.0 * next())
+                } else {
+                    None
+                };
+                (20.0 * next(), y, psi)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn plain_path_equals_general_path_bit_for_bit() {
+        let m = model(&[]);
+        let mut fast = Predictor::<4>::new(&m).unwrap();
+        let mut slow = fast.clone();
+        slow.plain = false;
+        let fu: std::vec::Vec<f32> = (0..19).map(|i| (i as f32 * 0.7).sin() * 5.0).collect();
+        for (u, y, psi) in inputs(500) {
+            assert_eq!(
+                fast.update_with_heading(u, y, psi),
+                slow.update_with_heading(u, y, psi)
+            );
+            let (sf, ss) = (fast.state(), slow.state());
+            for i in 0..4 {
+                assert_eq!(sf.x[i].to_bits(), ss.x[i].to_bits());
+            }
+            assert_eq!(sf.psi.to_bits(), ss.psi.to_bits());
+            assert_eq!(sf.u_prev.to_bits(), ss.u_prev.to_bits());
+            let (mut of, mut os) = ([0.0f32; 20], [0.0f32; 20]);
+            fast.predict_into(&mut of, &fu).unwrap();
+            slow.predict_into(&mut os, &fu).unwrap();
+            assert_eq!(of.map(f32::to_bits), os.map(f32::to_bits));
+        }
+    }
+
+    #[test]
+    fn prediction_equals_updates_without_measurements() {
+        let all = [
+            Effect::Bias { beta: 0.2 },
+            Effect::GyroBias { d_y: -0.3 },
+            Effect::DeadTime { samples: 3 },
+            Effect::RateLimit { rate: 4.0 },
+            Effect::Saturation { limit: 6.0 },
+            Effect::Asymmetry { beta: 0.1 },
+            Effect::NonlinearDamping {
+                beta: -0.05,
+                cubic: false,
+            },
+            Effect::Wind {
+                beta_s2: 0.3,
+                beta_c2: -0.2,
+                beta_s1: 0.1,
+                beta_c1: 0.05,
+            },
+            Effect::Current {
+                beta_s: -0.2,
+                beta_c: 0.1,
+            },
+        ];
+        for effects in [&[][..], &all[..]] {
+            let mut p = Predictor::<4>::new(&model(effects)).unwrap();
+            let data = inputs(300);
+            for (t, &(u, y, psi)) in data.iter().enumerate() {
+                p.update_with_heading(u, y, psi);
+                let fu: std::vec::Vec<f32> = data[t + 1..].iter().take(15).map(|d| d.0).collect();
+                let h = fu.len() + 1;
+                let mut out = [0.0f32; 16];
+                p.predict_into(&mut out[..h], &fu).unwrap();
+                // the same steps as updates with a missing measurement
+                let mut q = p.clone();
+                assert_eq!(out[0].to_bits(), q.prediction().to_bits());
+                for j in 1..h {
+                    assert_eq!(
+                        q.update(fu[j - 1], f32::NAN),
+                        UpdateStatus::SkippedCorrection
+                    );
+                    assert_eq!(out[j].to_bits(), q.prediction().to_bits(), "t={t} j={j}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn actuator_chain() {
+        // dead time 3: ũ(t) = u(t−3)
+        let mut p = Predictor::<4>::new(&model(&[Effect::DeadTime { samples: 3 }])).unwrap();
+        let mut seen = std::vec::Vec::new();
+        for u in 1..=6 {
+            p.update(u as f32, 0.0);
+            seen.push(p.state().u_prev);
+        }
+        assert_eq!(seen, [0.0, 0.0, 0.0, 1.0, 2.0, 3.0]);
+        // rate limit 2 deg/s at ts 0.5: at most 1 per step; saturation at 2.5
+        let m = model(&[
+            Effect::RateLimit { rate: 2.0 },
+            Effect::Saturation { limit: 2.5 },
+        ]);
+        let mut p = Predictor::<4>::new(&m).unwrap();
+        let mut seen = std::vec::Vec::new();
+        for u in [10.0, 10.0, 10.0, 10.0, -0.5, -10.0] {
+            p.update(u, 0.0);
+            seen.push(p.state().u_prev);
+        }
+        assert_eq!(seen, [1.0, 2.0, 2.5, 2.5, 1.5, 0.5]);
+    }
+
+    /// From the zero state one update gives x̂'_i = (0 + b_i·v) + k_i·e, so v can be checked
+    /// against a hand evaluation of each effect.
+    fn x_after_one(effects: &[Effect], u: f32, y: f32, psi: Option<f32>) -> [f32; 4] {
+        let mut p = Predictor::<4>::new(&model(effects)).unwrap();
+        p.update_with_heading(u, y, psi);
+        p.state().x
+    }
+
+    fn expected(v: f32, e: f32) -> [f32; 4] {
+        core::array::from_fn(|i| 0.0 + B[i] * v + K[i] * e)
+    }
+
+    #[test]
+    fn each_effect_enters_as_specified() {
+        let (u, y) = (3.0f32, -2.0f32);
+        assert_eq!(x_after_one(&[], u, y, None), expected(u, y));
+        assert_eq!(
+            x_after_one(&[Effect::Bias { beta: 0.5 }], u, y, None),
+            expected(u + 0.5, y)
+        );
+        assert_eq!(
+            x_after_one(&[Effect::GyroBias { d_y: 0.25 }], u, y, None),
+            expected(u, y - 0.25)
+        );
+        assert_eq!(
+            x_after_one(&[Effect::Asymmetry { beta: 0.5 }], u, y, None),
+            expected(u + 0.5 * u, y)
+        );
+        assert_eq!(
+            x_after_one(&[Effect::Asymmetry { beta: 0.5 }], -u, y, None),
+            expected(-u + 0.5 * 0.0, y)
+        );
+        let nld = |cubic| Effect::NonlinearDamping { beta: 0.5, cubic };
+        assert_eq!(
+            x_after_one(&[nld(false)], u, y, None),
+            expected(u + 0.5 * (y * 2.0), y)
+        );
+        assert_eq!(
+            x_after_one(&[nld(true)], u, y, None),
+            expected(u + 0.5 * (y * y * y), y)
+        );
+        // missing y: y_used = ŷ = 0, e = 0
+        assert_eq!(
+            x_after_one(&[nld(false)], u, f32::NAN, None),
+            expected(u + 0.5 * 0.0, 0.0)
+        );
+        let psi = 30.0f32;
+        let r = psi * DEG2RAD;
+        let (s1, c1) = libm::sincosf(r);
+        let (s2, c2) = libm::sincosf(r + r);
+        assert!((s1 - 0.5).abs() < 1e-6 && (s2 - 0.866_025_4).abs() < 1e-6);
+        let wind = Effect::Wind {
+            beta_s2: 0.1,
+            beta_c2: 0.2,
+            beta_s1: 0.3,
+            beta_c1: 0.4,
+        };
+        let v = u + 0.1 * s2 + 0.2 * c2 + 0.3 * s1 + 0.4 * c1;
+        assert_eq!(x_after_one(&[wind], u, y, Some(psi)), expected(v, y));
+        let cur = Effect::Current {
+            beta_s: 0.5,
+            beta_c: -0.5,
+        };
+        let v = u + 0.5 * s1 + -0.5 * c1;
+        assert_eq!(x_after_one(&[cur], u, y, Some(psi)), expected(v, y));
+        // non-finite heading falls back to the integrated one (0 at start)
+        assert_eq!(
+            x_after_one(&[cur], u, y, Some(f32::NAN)),
+            expected(u + 0.5 * 0.0 + -0.5 * 1.0, y)
+        );
+    }
+
+    #[test]
+    fn heading_integrates_rate_minus_gyro_bias() {
+        let m = model(&[Effect::GyroBias { d_y: 0.5 }]);
+        let mut p = Predictor::<4>::new(&m).unwrap();
+        p.update_with_heading(0.0, 2.5, Some(10.0));
+        assert_eq!(p.state().psi, 10.0 + 0.5 * (2.5 - 0.5));
+        p.update(0.0, 4.5);
+        assert_eq!(p.state().psi, 11.0 + 0.5 * 4.0);
+    }
+
+    #[test]
+    fn failures_are_values() {
+        let mut p = Predictor::<4>::new(&model(&[])).unwrap();
+        p.update(1.0, 1.0);
+        let before = p.state();
+        let mut out = [0.0f32; 65];
+        assert_eq!(
+            p.predict_into(&mut out, &[0.0; 64]),
+            Err(PredictorError::HorizonOutOfRange(65))
+        );
+        assert_eq!(
+            p.predict_into(&mut [], &[]),
+            Err(PredictorError::HorizonOutOfRange(0))
+        );
+        assert_eq!(
+            p.predict_into(&mut out[..5], &[1.0, f32::NAN, 0.0, 0.0]),
+            Err(PredictorError::NonFinite)
+        );
+        assert_eq!(
+            p.predict_into(&mut out[..5], &[1.0, 1.0, 1.0, f32::INFINITY]),
+            Err(PredictorError::NonFinite)
+        );
+        assert_eq!(p.state(), before);
+        assert_eq!(p.update(f32::NAN, 0.0), UpdateStatus::NonFiniteReset);
+        assert_eq!(p.state(), PredictorState::ZERO);
+        let m = model(&[Effect::DeadTime { samples: 2 }]);
+        let mut p = Predictor::<4>::new(&m).unwrap();
+        let mut s = p.state();
+        s.delay_head = 2;
+        assert_eq!(p.restore(s), Err(PredictorError::InvalidState));
+        s.delay_head = 1;
+        s.delay[5] = f32::NAN; // beyond the dead time: unused
+        assert_eq!(p.restore(s), Ok(()));
+        let mut bad = model(&[]);
+        bad.k[0] = 3.0;
+        assert_eq!(
+            Predictor::<4>::new(&bad).unwrap_err(),
+            PredictorError::InvalidModel(ModelError::UnstablePredictor)
+        );
+    }
+}

@@ -33,6 +33,11 @@ pub const MAX_ENCODED_LEN: usize = MAX_MESSAGE_LEN + MAX_MESSAGE_LEN / 254 + 1;
 /// Largest frame on the wire, delimiter included (387 bytes).
 pub const MAX_FRAME_LEN: usize = MAX_ENCODED_LEN + 1;
 
+/// Predicted outputs of a [`DeviceMessage::Prediction`] (at most [`MAX_HORIZON`]).
+pub type Values = Vec<f32, MAX_HORIZON>;
+/// Future commands of a [`HostMessage::PredictRequest`] (at most `MAX_HORIZON − 1`).
+pub type FutureInputs = Vec<f32, { MAX_HORIZON - 1 }>;
+
 /// Host → device.
 // Messages live on the stack of a no-alloc device: variants are inline by design.
 #[allow(clippy::large_enum_variant)]
@@ -57,7 +62,7 @@ pub enum HostMessage<'a> {
         /// H, `1..=MAX_HORIZON`.
         horizon: u8,
         /// Future commands u(t+1), u(t+2), ….
-        future_u: Vec<f32, { MAX_HORIZON - 1 }>,
+        future_u: FutureInputs,
     },
     /// Clear the predictor state (x̂, delay line, actuator, heading) and the sample counter.
     Reset,
@@ -106,7 +111,7 @@ pub enum DeviceMessage {
         /// Number of measurements the prediction is based on.
         sample: u32,
         /// The H predicted outputs.
-        values: Vec<f32, MAX_HORIZON>,
+        values: Values,
     },
     /// A request failed; the device keeps running.
     Error {
