@@ -4,4 +4,5 @@
 
 pub mod data;
 pub mod model;
+pub mod nmea;
 pub mod predict;

@@ -1,0 +1,966 @@
+//! NMEA 0183 trial logs → uniformly sampled [`Record`]s.
+//!
+//! # Sentences read
+//!
+//! | sentence | channel | unit conversion |
+//! |---|---|---|
+//! | `$--ROT` rate of turn | yaw rate `r` (required) | deg/min → deg/s; `-` = bow to port |
+//! | `$--RSA` rudder sensor angle | angle `δ` (required) | deg; both sensors valid → their mean |
+//! | `$--HDT` true heading | heading `ψ` | deg (unwrapped) |
+//! | `$--HDG` magnetic heading | heading `ψ` when no HDT | sensor + deviation + variation (E +) |
+//! | `$--VTG` course/speed over ground | speed `u` | knots (or km/h) → m/s |
+//! | `$--MWV` wind speed and angle | relative wind | `R` reference only; N/M/K/S → m/s |
+//! | `$--ZDA`, `$--RMC` | the clock | UTC time and date |
+//!
+//! HDT, VTG, MWV, ZDA and RMC are parsed by the `nmea` crate; ROT, RSA and HDG by the small
+//! parsers here ([`parse_rot`], [`parse_rsa`], [`parse_hdg`]). Other sentences are checked
+//! for their checksum and otherwise ignored. Text before the `$` on a line (a logger's own
+//! time stamp) is ignored.
+//!
+//! # Time
+//!
+//! Sentences carry no time of their own, so the log needs a clock:
+//!
+//! - [`Clock::Log`] (default): the `ZDA` sentences (else `RMC`) are the clock. The samples of a
+//!   channel between two clock sentences are spread evenly over that interval. When a channel
+//!   has fewer than half the samples its usual rate predicts in an interval, the interval holds
+//!   a gap: its samples keep the usual spacing from the interval start, and the gap shows up in
+//!   the gap check below. Sentences before the first clock sentence are dropped.
+//! - [`Clock::Rate`]`(hz)`: no clock in the log; the k-th `ROT` sentence is at `k/hz` seconds and
+//!   every other sentence takes the time of the latest `ROT`. Gaps cannot be seen this way.
+//!
+//! # Resampling
+//!
+//! Every channel present is linearly interpolated (heading and wind angle after unwrapping)
+//! onto a uniform grid of step [`NmeaOptions::ts`] (default: the usual `ROT` spacing, rounded
+//! to 1 ms) over the time span where every present channel has data. `t_s` counts from the
+//! first grid point. A channel whose samples are further apart than the gap limit anywhere
+//! in that span is an error naming the channel, the clock time and line where the gap starts,
+//! and its length. The limit is [`NmeaOptions::max_gap`], by default the larger of two grid
+//! steps and 2.5 times the channel's usual spacing.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use thiserror::Error;
+
+use crate::data::Record;
+
+/// Where sample times come from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Clock {
+    /// `ZDA` (else `RMC`) sentences in the log.
+    Log,
+    /// No clock: `ROT` sentences arrive at this rate (Hz).
+    Rate(f64),
+}
+
+/// How to read a log.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NmeaOptions {
+    /// The clock.
+    pub clock: Clock,
+    /// Grid step (s); `None` = the usual `ROT` spacing.
+    pub ts: Option<f64>,
+    /// Largest tolerated spacing of a channel's samples (s); `None` = see module docs.
+    pub max_gap: Option<f64>,
+    /// Drop sentences with a bad or missing checksum instead of failing.
+    pub skip_bad_checksums: bool,
+}
+
+impl Default for NmeaOptions {
+    fn default() -> Self {
+        NmeaOptions {
+            clock: Clock::Log,
+            ts: None,
+            max_gap: None,
+            skip_bad_checksums: false,
+        }
+    }
+}
+
+/// Errors reading an NMEA log.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum NmeaError {
+    /// The file could not be read.
+    #[error("{path}: {source}")]
+    Io {
+        /// File concerned.
+        path: PathBuf,
+        /// Underlying error.
+        source: std::io::Error,
+    },
+    /// The checksum after `*` does not match the sentence, or is missing.
+    #[error("{path}: line {line}: bad checksum: {detail} (pass --skip-bad-checksums to drop such lines)")]
+    Checksum {
+        /// File concerned.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// What was found and expected.
+        detail: String,
+    },
+    /// A sentence of a type we read has a field we cannot read.
+    #[error("{path}: line {line}: {sentence}: {message}")]
+    Malformed {
+        /// File concerned.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// Sentence type, e.g. `ROT`.
+        sentence: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// The clock runs backwards.
+    #[error("{path}: line {line}: clock goes back from {from} to {to}")]
+    ClockBackwards {
+        /// File concerned.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// Previous clock time (hh:mm:ss.ss).
+        from: String,
+        /// This clock time.
+        to: String,
+    },
+    /// The log has no usable clock.
+    #[error("{path}: {message}")]
+    NoClock {
+        /// File concerned.
+        path: PathBuf,
+        /// What is missing and what to do.
+        message: String,
+    },
+    /// A required channel has no valid sample.
+    #[error("{path}: no valid {sentence} sentence ({what}); it is required")]
+    Missing {
+        /// File concerned.
+        path: PathBuf,
+        /// Sentence type.
+        sentence: &'static str,
+        /// What it carries.
+        what: &'static str,
+    },
+    /// A channel has a hole longer than the gap limit.
+    #[error("{path}: gap of {length:.2} s in {sentence} ({what}) after {at} (line {line}); the limit is {limit:.2} s (--max-gap)")]
+    Gap {
+        /// File concerned.
+        path: PathBuf,
+        /// Sentence type of the channel.
+        sentence: &'static str,
+        /// What it carries.
+        what: &'static str,
+        /// Clock time of the last sample before the gap (hh:mm:ss.ss).
+        at: String,
+        /// 1-based line of that sample.
+        line: usize,
+        /// Length of the gap (s).
+        length: f64,
+        /// The limit in force (s).
+        limit: f64,
+    },
+    /// Too few grid points.
+    #[error("{path}: only {found} samples after resampling, at least {needed} needed")]
+    TooShort {
+        /// File concerned.
+        path: PathBuf,
+        /// Samples found.
+        found: usize,
+        /// Samples needed.
+        needed: usize,
+    },
+    /// A bad option value.
+    #[error("{0}")]
+    Option(String),
+}
+
+/// XOR checksum of the characters between `$` and `*`.
+///
+/// ```
+/// assert_eq!(yawcast::nmea::checksum("GPHDT,274.07,T"), 0x03);
+/// ```
+pub fn checksum(body: &str) -> u8 {
+    body.bytes().fold(0, |c, b| c ^ b)
+}
+
+/// Whether `text` looks like an NMEA log (its first non-blank line holds a `$` sentence
+/// before any comma).
+///
+/// ```
+/// use yawcast::nmea::looks_like_nmea;
+/// assert!(looks_like_nmea("\n$HEROT,1.0,A*2A\n"));
+/// assert!(!looks_like_nmea("t_s,delta_deg,r_degps\n"));
+/// ```
+pub fn looks_like_nmea(text: &str) -> bool {
+    let Some(line) = text.lines().map(str::trim).find(|l| !l.is_empty()) else {
+        return false;
+    };
+    match (line.find('$'), line.find(',')) {
+        (Some(d), Some(c)) => d < c,
+        (Some(_), None) => true,
+        _ => false,
+    }
+}
+
+/// Parses the fields of a `ROT` sentence (after `$--ROT,`, before `*`): the rate of turn in
+/// deg/s, or `None` when the status is `V` (invalid) or the field is empty.
+///
+/// # Errors
+/// A message when the rate is not a number or the status is not `A`/`V`.
+///
+/// ```
+/// use yawcast::nmea::parse_rot;
+/// assert_eq!(parse_rot("-12.0,A"), Ok(Some(-0.2)));
+/// assert_eq!(parse_rot("3.0,V"), Ok(None));
+/// assert!(parse_rot("fast,A").is_err());
+/// ```
+pub fn parse_rot(fields: &str) -> Result<Option<f64>, String> {
+    let f: Vec<&str> = fields.split(',').collect();
+    let rate = num_field(f.first().copied(), "rate of turn (deg/min)")?;
+    match f.get(1).copied().unwrap_or("A") {
+        "A" | "" => Ok(rate.map(|r| r / 60.0)),
+        "V" => Ok(None),
+        s => Err(format!("status must be A or V, found `{s}`")),
+    }
+}
+
+/// Parses the fields of an `RSA` sentence: starboard (or single) and port rudder sensor
+/// angles, each with status `A`/`V`. Returns the mean of the valid ones (deg), `None` when
+/// neither is valid.
+///
+/// # Errors
+/// A message when an angle is not a number or a status is not `A`/`V`.
+///
+/// ```
+/// use yawcast::nmea::parse_rsa;
+/// assert_eq!(parse_rsa("10.0,A,,V"), Ok(Some(10.0)));
+/// assert_eq!(parse_rsa("10.0,A,12.0,A"), Ok(Some(11.0)));
+/// assert_eq!(parse_rsa("10.0,V,,"), Ok(None));
+/// assert!(parse_rsa("ten,A,,").is_err());
+/// ```
+pub fn parse_rsa(fields: &str) -> Result<Option<f64>, String> {
+    let f: Vec<&str> = fields.split(',').collect();
+    let mut sum = 0.0;
+    let mut count = 0;
+    for (i, side) in [(0, "starboard"), (2, "port")] {
+        let angle = num_field(f.get(i).copied(), &format!("{side} rudder angle (deg)"))?;
+        let ok = match f.get(i + 1).copied().unwrap_or("") {
+            "A" => true,
+            "V" | "" => false,
+            s => return Err(format!("{side} status must be A or V, found `{s}`")),
+        };
+        if let (true, Some(a)) = (ok, angle) {
+            sum += a;
+            count += 1;
+        }
+    }
+    Ok((count > 0).then(|| sum / count as f64))
+}
+
+/// Parses the fields of an `HDG` sentence: true heading (deg) = magnetic sensor heading +
+/// deviation + variation (east positive; an empty deviation or variation counts as 0).
+///
+/// # Errors
+/// A message when a number is malformed or a direction is not `E`/`W`.
+///
+/// ```
+/// use yawcast::nmea::parse_hdg;
+/// assert_eq!(parse_hdg("100.0,2.0,W,5.0,E"), Ok(Some(103.0)));
+/// assert_eq!(parse_hdg("100.0,,,,"), Ok(Some(100.0)));
+/// assert_eq!(parse_hdg(",,,,"), Ok(None));
+/// ```
+pub fn parse_hdg(fields: &str) -> Result<Option<f64>, String> {
+    let f: Vec<&str> = fields.split(',').collect();
+    let Some(h) = num_field(f.first().copied(), "magnetic sensor heading (deg)")? else {
+        return Ok(None);
+    };
+    let mut total = h;
+    for (i, what) in [(1, "deviation"), (3, "variation")] {
+        let v = num_field(f.get(i).copied(), what)?.unwrap_or(0.0);
+        total += match f.get(i + 1).copied().unwrap_or("") {
+            "E" | "" => v,
+            "W" => -v,
+            s => return Err(format!("{what} direction must be E or W, found `{s}`")),
+        };
+    }
+    Ok(Some(total.rem_euclid(360.0)))
+}
+
+fn num_field(f: Option<&str>, what: &str) -> Result<Option<f64>, String> {
+    match f.map(str::trim) {
+        None | Some("") => Ok(None),
+        Some(s) => match s.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(Some(v)),
+            _ => Err(format!("{what}: expected a number, found `{s}`")),
+        },
+    }
+}
+
+/// The channels of a record, in the order they are resampled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Chan {
+    Rate,
+    Angle,
+    Heading,
+    Speed,
+    WindSpeed,
+    WindAngle,
+}
+
+impl Chan {
+    fn sentence(self) -> &'static str {
+        match self {
+            Chan::Rate => "ROT",
+            Chan::Angle => "RSA",
+            Chan::Heading => "HDT/HDG",
+            Chan::Speed => "VTG",
+            Chan::WindSpeed | Chan::WindAngle => "MWV",
+        }
+    }
+    fn what(self) -> &'static str {
+        match self {
+            Chan::Rate => "rate of turn",
+            Chan::Angle => "rudder angle",
+            Chan::Heading => "heading",
+            Chan::Speed => "speed over ground",
+            Chan::WindSpeed => "relative wind speed",
+            Chan::WindAngle => "relative wind angle",
+        }
+    }
+    fn angular(self) -> bool {
+        matches!(self, Chan::Heading | Chan::WindAngle)
+    }
+}
+
+/// One parsed sentence that matters: a clock tick or a channel value.
+#[derive(Debug, Clone, Copy)]
+enum Item {
+    Clock(f64),
+    Value(Chan, f64),
+    /// A ROT tick when the clock is the ROT count (value may be invalid).
+    RotTick,
+}
+
+/// Reads an NMEA 0183 log into a uniformly sampled record.
+///
+/// # Errors
+/// [`NmeaError`] naming the file, line, sentence or gap.
+pub fn read_nmea(path: &Path, opts: &NmeaOptions) -> Result<Record, NmeaError> {
+    let bytes = std::fs::read(path).map_err(|source| NmeaError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let text = String::from_utf8_lossy(&bytes);
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    parse_nmea(&text, path, &name, opts)
+}
+
+/// Parses NMEA log text (`path` only labels errors).
+///
+/// # Errors
+/// As [`read_nmea`].
+///
+/// ```
+/// use yawcast::nmea::{parse_nmea, NmeaOptions, Clock};
+/// let log = "$HEROT,60.0,A*1D\n$IIRSA,5.0,A,,V*7C\n$HEROT,120.0,A*28\n$IIRSA,6.0,A,,V*7F\n\
+///            $HEROT,60.0,A*1D\n$IIRSA,5.0,A,,V*7C\n";
+/// let opts = NmeaOptions { clock: Clock::Rate(2.0), ..NmeaOptions::default() };
+/// let r = parse_nmea(log, "x.nmea".as_ref(), "x", &opts).unwrap();
+/// assert_eq!(r.ts, 0.5);
+/// assert_eq!(r.y, vec![1.0, 2.0, 1.0]);
+/// assert_eq!(r.u, vec![5.0, 6.0, 5.0]);
+/// ```
+pub fn parse_nmea(
+    text: &str,
+    path: &Path,
+    name: &str,
+    opts: &NmeaOptions,
+) -> Result<Record, NmeaError> {
+    if let Clock::Rate(hz) = opts.clock {
+        if !(hz.is_finite() && hz > 0.0) {
+            return Err(NmeaError::Option(format!(
+                "the ROT rate must be a positive number of Hz, found {hz}"
+            )));
+        }
+    }
+    for (v, what) in [(opts.ts, "grid step"), (opts.max_gap, "gap limit")] {
+        if let Some(v) = v {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(NmeaError::Option(format!(
+                    "the {what} must be a positive number of seconds, found {v}"
+                )));
+            }
+        }
+    }
+    let items = scan(text, path, opts)?;
+    let series = timestamp(&items, path, opts)?;
+    resample(series, path, name, opts)
+}
+
+/// Pass 1: every line → items, checksums verified.
+fn scan(text: &str, path: &Path, opts: &NmeaOptions) -> Result<Vec<(usize, Item)>, NmeaError> {
+    let mut out = Vec::new();
+    let has_hdt = text.contains("HDT,");
+    let has_zda = text.contains("ZDA,");
+    for (i, raw) in text.lines().enumerate() {
+        let line = i + 1;
+        let Some(start) = raw.find('$') else {
+            continue;
+        };
+        let s = raw[start..].trim_end();
+        let bad = |detail: String| NmeaError::Checksum {
+            path: path.to_path_buf(),
+            line,
+            detail,
+        };
+        let (body, given) = match s.rfind('*') {
+            Some(star) => (&s[1..star], Some(&s[star + 1..])),
+            None => (&s[1..], None),
+        };
+        let computed = checksum(body);
+        let ok = match given {
+            None => Err(bad("no `*hh` checksum".into())),
+            Some(g) => match u8::from_str_radix(g.trim(), 16) {
+                Ok(v) if g.trim().len() == 2 && v == computed => Ok(()),
+                _ => Err(bad(format!(
+                    "the sentence says `{g}`, its characters give `{computed:02X}`"
+                ))),
+            },
+        };
+        if let Err(e) = ok {
+            if opts.skip_bad_checksums {
+                continue;
+            }
+            return Err(e);
+        }
+        if body.len() < 6 || !body.is_ascii() {
+            continue;
+        }
+        let kind = &body[2..5];
+        let fields = body.get(6..).unwrap_or("");
+        let malformed = |message: String| NmeaError::Malformed {
+            path: path.to_path_buf(),
+            line,
+            sentence: kind.to_string(),
+            message,
+        };
+        match kind {
+            "ROT" => {
+                let v = parse_rot(fields).map_err(malformed)?;
+                if matches!(opts.clock, Clock::Rate(_)) {
+                    out.push((line, Item::RotTick));
+                }
+                if let Some(v) = v {
+                    out.push((line, Item::Value(Chan::Rate, v)));
+                }
+            }
+            "RSA" => {
+                if let Some(v) = parse_rsa(fields).map_err(malformed)? {
+                    out.push((line, Item::Value(Chan::Angle, v)));
+                }
+            }
+            "HDG" if !has_hdt => {
+                if let Some(v) = parse_hdg(fields).map_err(malformed)? {
+                    out.push((line, Item::Value(Chan::Heading, v)));
+                }
+            }
+            "HDT" | "VTG" | "MWV" | "ZDA" | "RMC" => {
+                let parsed = nmea::parse_str(s)
+                    .map_err(|e| malformed(format!("cannot read the sentence ({e:?})")))?;
+                match parsed {
+                    nmea::ParseResult::HDT(h) => {
+                        if let Some(v) = h.heading {
+                            out.push((line, Item::Value(Chan::Heading, f64::from(v))));
+                        }
+                    }
+                    nmea::ParseResult::VTG(v) => {
+                        if let Some(kn) = v.speed_over_ground {
+                            out.push((line, Item::Value(Chan::Speed, knots(f64::from(kn)))));
+                        }
+                    }
+                    nmea::ParseResult::MWV(w) => {
+                        use nmea::sentences::mwv::{MwvReference, MwvWindSpeedUnits as U};
+                        if w.data_valid && w.reference == Some(MwvReference::Relative) {
+                            if let (Some(a), Some(sp), Some(unit)) =
+                                (w.wind_direction, w.wind_speed, w.wind_speed_units)
+                            {
+                                let sp = f64::from(sp);
+                                let mps = match unit {
+                                    U::MetersPerSecond => sp,
+                                    U::Knots => knots(sp),
+                                    U::KilometersPerHour => sp / 3.6,
+                                    U::MilesPerHour => sp * 0.447_04,
+                                };
+                                out.push((line, Item::Value(Chan::WindSpeed, mps)));
+                                out.push((line, Item::Value(Chan::WindAngle, f64::from(a))));
+                            }
+                        }
+                    }
+                    nmea::ParseResult::ZDA(z) if opts.clock == Clock::Log => {
+                        if let Some(t) = z.utc_time {
+                            let day = match (z.year, z.month, z.day) {
+                                (Some(y), Some(m), Some(d)) => days_from_civil(
+                                    i64::from(y),
+                                    i64::from(m),
+                                    i64::from(d),
+                                ),
+                                _ => None,
+                            };
+                            out.push((line, Item::Clock(clock_seconds(t, day))));
+                        }
+                    }
+                    nmea::ParseResult::RMC(r) if opts.clock == Clock::Log && !has_zda => {
+                        if let Some(t) = r.fix_time {
+                            use chrono::Datelike;
+                            let day = r.fix_date.map(|d| {
+                                days_from_civil(
+                                    i64::from(d.year()),
+                                    i64::from(d.month()),
+                                    i64::from(d.day()),
+                                )
+                            });
+                            out.push((line, Item::Clock(clock_seconds(t, day.flatten()))));
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(out)
+}
+
+fn knots(kn: f64) -> f64 {
+    kn * 1852.0 / 3600.0
+}
+
+fn clock_seconds(t: chrono::NaiveTime, day: Option<i64>) -> f64 {
+    use chrono::Timelike;
+    let s = f64::from(t.num_seconds_from_midnight()) + f64::from(t.nanosecond()) * 1e-9;
+    match day {
+        Some(d) => d as f64 * 86_400.0 + s,
+        None => s,
+    }
+}
+
+/// Days since 1970-01-01 of a civil date (proleptic Gregorian), `None` for an invalid date.
+fn days_from_civil(y: i64, m: i64, d: i64) -> Option<i64> {
+    if !(1..=12).contains(&m) || !(1..=31).contains(&d) {
+        return None;
+    }
+    let y = if m <= 2 { y - 1 } else { y };
+    let era = y.div_euclid(400);
+    let yoe = y - era * 400;
+    let mp = (m + 9) % 12;
+    let doy = (153 * mp + 2) / 5 + d - 1;
+    let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+    Some(era * 146_097 + doe - 719_468)
+}
+
+/// hh:mm:ss.ss of a clock value (seconds, possibly with a day offset).
+fn hms(t: f64) -> String {
+    let s = t.rem_euclid(86_400.0);
+    let h = (s / 3600.0).floor();
+    let m = ((s - h * 3600.0) / 60.0).floor();
+    let sec = s - h * 3600.0 - m * 60.0;
+    format!("{:02}:{:02}:{:05.2}", h as u32, m as u32, sec)
+}
+
+/// A channel's samples: (time, value, line).
+type Series = BTreeMap<Chan, Vec<(f64, f64, usize)>>;
+
+/// Pass 2: items → time-stamped series per channel.
+fn timestamp(
+    items: &[(usize, Item)],
+    path: &Path,
+    opts: &NmeaOptions,
+) -> Result<Series, NmeaError> {
+    let mut series: Series = BTreeMap::new();
+    if let Clock::Rate(hz) = opts.clock {
+        let mut ticks = 0usize;
+        let mut now = None;
+        for &(line, it) in items {
+            match it {
+                Item::RotTick => {
+                    now = Some(ticks as f64 / hz);
+                    ticks += 1;
+                }
+                Item::Value(c, v) => {
+                    if let Some(t) = now {
+                        series.entry(c).or_default().push((t, v, line));
+                    }
+                }
+                Item::Clock(_) => {}
+            }
+        }
+        return Ok(series);
+    }
+    // Clock ticks, with midnight roll-over for undated clocks.
+    let mut clocks: Vec<(usize, f64, usize)> = Vec::new(); // (item index, time, line)
+    let mut roll = 0.0;
+    for (idx, &(line, it)) in items.iter().enumerate() {
+        if let Item::Clock(raw) = it {
+            let mut t = raw + roll;
+            if let Some(&(_, prev, _)) = clocks.last() {
+                if raw < 86_400.0 && t < prev - 43_200.0 {
+                    roll += 86_400.0;
+                    t += 86_400.0;
+                }
+                if t < prev {
+                    return Err(NmeaError::ClockBackwards {
+                        path: path.to_path_buf(),
+                        line,
+                        from: hms(prev),
+                        to: hms(t),
+                    });
+                }
+                if t == prev {
+                    continue;
+                }
+            }
+            clocks.push((idx, t, line));
+        }
+    }
+    if clocks.len() < 2 {
+        return Err(NmeaError::NoClock {
+            path: path.to_path_buf(),
+            message: format!(
+                "{} ZDA/RMC clock sentence(s) with a time; at least 2 are needed \
+                 (or give the ROT rate with --nmea-rate HZ)",
+                clocks.len()
+            ),
+        });
+    }
+    let mut dts: Vec<f64> = clocks.windows(2).map(|w| w[1].1 - w[0].1).collect();
+    dts.sort_by(f64::total_cmp);
+    let dt_med = dts[dts.len() / 2];
+    // Items per interval, per channel. The interval after the last clock gets the median length.
+    let n_int = clocks.len();
+    let interval = |k: usize| -> (usize, usize, f64, f64) {
+        let (i0, t0, _) = clocks[k];
+        match clocks.get(k + 1) {
+            Some(&(i1, t1, _)) => (i0, i1, t0, t1 - t0),
+            None => (i0, items.len(), t0, dt_med),
+        }
+    };
+    // Usual rate of each channel: median over normal-length intervals of count/Δ.
+    let mut rates: BTreeMap<Chan, Vec<f64>> = BTreeMap::new();
+    let mut counts: Vec<BTreeMap<Chan, usize>> = Vec::with_capacity(n_int);
+    for k in 0..n_int {
+        let (i0, i1, _, dt) = interval(k);
+        let mut c: BTreeMap<Chan, usize> = BTreeMap::new();
+        for &(_, it) in &items[i0..i1] {
+            if let Item::Value(ch, _) = it {
+                *c.entry(ch).or_default() += 1;
+            }
+        }
+        if dt <= 1.5 * dt_med && k + 1 < n_int {
+            for (&ch, &m) in &c {
+                rates.entry(ch).or_default().push(m as f64 / dt);
+            }
+        }
+        counts.push(c);
+    }
+    let rate_of = |ch: Chan| -> f64 {
+        match rates.get(&ch) {
+            Some(v) if !v.is_empty() => {
+                let mut v = v.clone();
+                v.sort_by(f64::total_cmp);
+                v[v.len() / 2]
+            }
+            _ => 1.0 / dt_med,
+        }
+    };
+    for k in 0..n_int {
+        let (i0, i1, t0, dt) = interval(k);
+        let mut seen: BTreeMap<Chan, usize> = BTreeMap::new();
+        for &(line, it) in &items[i0..i1] {
+            if let Item::Value(ch, v) = it {
+                let m = counts[k][&ch];
+                let j = seen.entry(ch).or_default();
+                let rate = rate_of(ch);
+                let step = if (m as f64) >= 0.5 * rate * dt {
+                    dt / m as f64
+                } else {
+                    1.0 / rate
+                };
+                series
+                    .entry(ch)
+                    .or_default()
+                    .push((t0 + *j as f64 * step, v, line));
+                *j += 1;
+            }
+        }
+    }
+    Ok(series)
+}
+
+/// Pass 3: gap check and resampling onto the grid.
+fn resample(
+    series: Series,
+    path: &Path,
+    name: &str,
+    opts: &NmeaOptions,
+) -> Result<Record, NmeaError> {
+    for (ch, sentence, what) in [
+        (Chan::Rate, "ROT", "rate of turn"),
+        (Chan::Angle, "RSA", "rudder sensor angle"),
+    ] {
+        if series.get(&ch).is_none_or(|v| v.len() < 2) {
+            return Err(NmeaError::Missing {
+                path: path.to_path_buf(),
+                sentence,
+                what,
+            });
+        }
+    }
+    let spacing = |v: &[(f64, f64, usize)]| -> f64 {
+        let mut d: Vec<f64> = v
+            .windows(2)
+            .map(|w| w[1].0 - w[0].0)
+            .filter(|d| *d > 0.0)
+            .collect();
+        if d.is_empty() {
+            return f64::INFINITY;
+        }
+        d.sort_by(f64::total_cmp);
+        d[d.len() / 2]
+    };
+    let ts = match opts.ts {
+        Some(ts) => ts,
+        None => {
+            let s = spacing(&series[&Chan::Rate]);
+            ((s * 1000.0).round() / 1000.0).max(0.001)
+        }
+    };
+    let t_start = series
+        .values()
+        .map(|v| v[0].0)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let t_end = series
+        .values()
+        .map(|v| v[v.len() - 1].0)
+        .fold(f64::INFINITY, f64::min);
+    // Gap check within the common span.
+    for (&ch, v) in &series {
+        let limit = opts.max_gap.unwrap_or_else(|| (2.0 * ts).max(2.5 * spacing(v)));
+        for w in v.windows(2) {
+            let (a, b) = (w[0].0, w[1].0);
+            if b > t_start && a < t_end && b - a > limit {
+                return Err(NmeaError::Gap {
+                    path: path.to_path_buf(),
+                    sentence: ch.sentence(),
+                    what: ch.what(),
+                    at: hms(a),
+                    line: w[0].2,
+                    length: b - a,
+                    limit,
+                });
+            }
+        }
+    }
+    let n = if t_end >= t_start {
+        ((t_end - t_start) / ts + 1e-9).floor() as usize + 1
+    } else {
+        0
+    };
+    if n < 2 {
+        return Err(NmeaError::TooShort {
+            path: path.to_path_buf(),
+            found: n,
+            needed: 2,
+        });
+    }
+    let grid: Vec<f64> = (0..n).map(|i| t_start + i as f64 * ts).collect();
+    let mut rec = Record {
+        name: name.to_string(),
+        ts,
+        t: (0..n).map(|i| round_us(i as f64 * ts)).collect(),
+        ..Record::default()
+    };
+    for (&ch, v) in &series {
+        let vals = interp(v, &grid, ch.angular());
+        match ch {
+            Chan::Rate => rec.y = vals,
+            Chan::Angle => rec.u = vals,
+            Chan::Heading => rec.psi = Some(vals),
+            Chan::Speed => rec.speed = Some(vals),
+            Chan::WindSpeed => rec.wind_speed = Some(vals),
+            Chan::WindAngle => {
+                rec.wind_angle = Some(vals.into_iter().map(|a| a.rem_euclid(360.0)).collect())
+            }
+        }
+    }
+    Ok(rec)
+}
+
+fn round_us(t: f64) -> f64 {
+    (t * 1e6).round() / 1e6
+}
+
+/// Linear interpolation of `v` (sorted by time; equal times keep the last) at `grid`;
+/// angular channels are unwrapped first.
+fn interp(v: &[(f64, f64, usize)], grid: &[f64], angular: bool) -> Vec<f64> {
+    let mut ts: Vec<f64> = Vec::with_capacity(v.len());
+    let mut xs: Vec<f64> = Vec::with_capacity(v.len());
+    for &(t, x, _) in v {
+        let x = match (angular, xs.last()) {
+            (true, Some(&prev)) => prev + (x - prev + 180.0).rem_euclid(360.0) - 180.0,
+            _ => x,
+        };
+        if ts.last() == Some(&t) {
+            *xs.last_mut().unwrap_or(&mut 0.0) = x;
+        } else {
+            ts.push(t);
+            xs.push(x);
+        }
+    }
+    let mut j = 0;
+    grid.iter()
+        .map(|&g| {
+            while j + 2 < ts.len() && ts[j + 1] < g {
+                j += 1;
+            }
+            if ts.len() == 1 {
+                return xs[0];
+            }
+            let (t0, t1) = (ts[j], ts[j + 1]);
+            let w = ((g - t0) / (t1 - t0)).clamp(0.0, 1.0);
+            let x = xs[j] + w * (xs[j + 1] - xs[j]);
+            round_us(x)
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TRIAL: &str = include_str!("../tests/data/trial.nmea");
+    const BAD: &str = include_str!("../tests/data/trial-bad-checksum.nmea");
+    const GAP: &str = include_str!("../tests/data/trial-gap.nmea");
+
+    fn parse(text: &str, opts: &NmeaOptions) -> Result<Record, NmeaError> {
+        parse_nmea(text, Path::new("trial.nmea"), "trial", opts)
+    }
+
+    #[test]
+    fn golden_log_every_sentence_type() {
+        let r = parse(TRIAL, &NmeaOptions::default()).unwrap();
+        assert_eq!(r.ts, 0.5);
+        assert_eq!(r.len(), 19);
+        let t: Vec<f64> = (0..19).map(|i| i as f64 * 0.5).collect();
+        assert_eq!(r.t, t);
+        // ROT 6·t deg/min = 0.1·t deg/s; the invalid ROT at 2.5 s is interpolated over.
+        for (i, &ti) in t.iter().enumerate() {
+            assert!((r.y[i] - 0.1 * ti).abs() < 1e-9, "r at {ti}: {}", r.y[i]);
+            let d = if ti < 5.0 { 10.0 } else { -10.0 };
+            assert_eq!(r.u[i], d, "δ at {ti}");
+        }
+        // HDT 358 + 0.5 t, unwrapped across north; HDG is ignored when HDT is logged.
+        let psi = r.psi.as_ref().unwrap();
+        assert_eq!(psi[0], 358.0);
+        assert_eq!(psi[1], 358.25);
+        assert_eq!(psi[18], 362.5);
+        // VTG 3 kn; MWV relative 10 kn at 356 + t deg (wrapped), true-wind MWV ignored.
+        assert!(r.speed.as_ref().unwrap().iter().all(|&v| v == 1.543333));
+        assert!(r.wind_speed.as_ref().unwrap().iter().all(|&v| v == 5.144444));
+        let wa = r.wind_angle.as_ref().unwrap();
+        assert_eq!(wa[0], 356.0);
+        assert_eq!(wa[8], 0.0);
+        assert_eq!(wa[18], 5.0);
+    }
+
+    #[test]
+    fn bad_checksum_names_the_line() {
+        let e = parse(BAD, &NmeaOptions::default()).unwrap_err();
+        assert!(matches!(e, NmeaError::Checksum { line: 49, .. }), "{e}");
+        let msg = e.to_string();
+        assert!(msg.contains("trial.nmea: line 49: bad checksum"), "{msg}");
+        // Dropping the line instead: the ROT sample at 4.0 s is interpolated from its neighbours.
+        let opts = NmeaOptions {
+            skip_bad_checksums: true,
+            ..NmeaOptions::default()
+        };
+        let r = parse(BAD, &opts).unwrap();
+        assert_eq!(r.len(), 19);
+    }
+
+    #[test]
+    fn gap_names_time_line_and_length() {
+        let e = parse(GAP, &NmeaOptions::default()).unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            matches!(e, NmeaError::Gap { line: 40, sentence: "ROT", .. }),
+            "{msg}"
+        );
+        assert!(
+            msg.contains("gap of 3.50 s in ROT (rate of turn) after 12:00:03.50 (line 40)"),
+            "{msg}"
+        );
+        // A generous limit lets it through.
+        let opts = NmeaOptions {
+            max_gap: Some(4.0),
+            ..NmeaOptions::default()
+        };
+        assert_eq!(parse(GAP, &opts).unwrap().len(), 19);
+    }
+
+    #[test]
+    fn hdg_and_rmc_clock_without_hdt_and_zda() {
+        let log: String = TRIAL
+            .lines()
+            .filter(|l| !l.contains("HDT") && !l.contains("ZDA"))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let r = parse(&log, &NmeaOptions::default()).unwrap();
+        assert_eq!(r.len(), 19);
+        assert_eq!(r.psi.as_ref().unwrap()[18], 362.5);
+    }
+
+    #[test]
+    fn rate_clock_and_grid_option() {
+        let opts = NmeaOptions {
+            clock: Clock::Rate(2.0),
+            ts: Some(1.0),
+            ..NmeaOptions::default()
+        };
+        let r = parse(TRIAL, &opts).unwrap();
+        assert_eq!(r.ts, 1.0);
+        // Every ROT ticks the clock (the invalid one too); heading starts at the 2nd tick.
+        assert!((r.y[3] - 0.35).abs() < 1e-9, "{:?}", r.y);
+    }
+
+    #[test]
+    fn clear_errors() {
+        let e = parse("$GPZDA,120000.00,14,06,2024,00,00*62\n", &NmeaOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("at least 2") && e.contains("--nmea-rate"), "{e}");
+        let no_rsa: String = TRIAL
+            .lines()
+            .filter(|l| !l.contains("RSA"))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let e = parse(&no_rsa, &NmeaOptions::default()).unwrap_err().to_string();
+        assert!(e.contains("no valid RSA sentence"), "{e}");
+        let e = parse("$HEROT,abc,A*65\n", &NmeaOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("line 1: ROT") && e.contains("`abc`"), "{e}");
+        let e = parse(
+            "$GPZDA,120001.00,14,06,2024,00,00*63\n$GPZDA,120000.00,14,06,2024,00,00*62\n",
+            &NmeaOptions::default(),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("line 2: clock goes back"), "{e}");
+        assert!(!looks_like_nmea(""));
+    }
+}
