@@ -504,11 +504,9 @@ fn scan(text: &str, path: &Path, opts: &NmeaOptions) -> Result<Vec<(usize, Item)
                     nmea::ParseResult::ZDA(z) if opts.clock == Clock::Log => {
                         if let Some(t) = z.utc_time {
                             let day = match (z.year, z.month, z.day) {
-                                (Some(y), Some(m), Some(d)) => days_from_civil(
-                                    i64::from(y),
-                                    i64::from(m),
-                                    i64::from(d),
-                                ),
+                                (Some(y), Some(m), Some(d)) => {
+                                    days_from_civil(i64::from(y), i64::from(m), i64::from(d))
+                                }
                                 _ => None,
                             };
                             out.push((line, Item::Clock(clock_seconds(t, day))));
@@ -712,7 +710,7 @@ fn resample(
         (Chan::Rate, "ROT", "rate of turn"),
         (Chan::Angle, "RSA", "rudder sensor angle"),
     ] {
-        if series.get(&ch).is_none_or(|v| v.len() < 2) {
+        if !series.get(&ch).is_some_and(|v| v.len() >= 2) {
             return Err(NmeaError::Missing {
                 path: path.to_path_buf(),
                 sentence,
@@ -749,7 +747,9 @@ fn resample(
         .fold(f64::INFINITY, f64::min);
     // Gap check within the common span.
     for (&ch, v) in &series {
-        let limit = opts.max_gap.unwrap_or_else(|| (2.0 * ts).max(2.5 * spacing(v)));
+        let limit = opts
+            .max_gap
+            .unwrap_or_else(|| (2.0 * ts).max(2.5 * spacing(v)));
         for w in v.windows(2) {
             let (a, b) = (w[0].0, w[1].0);
             if b > t_start && a < t_end && b - a > limit {
@@ -870,7 +870,12 @@ mod tests {
         assert_eq!(psi[18], 362.5);
         // VTG 3 kn; MWV relative 10 kn at 356 + t deg (wrapped), true-wind MWV ignored.
         assert!(r.speed.as_ref().unwrap().iter().all(|&v| v == 1.543333));
-        assert!(r.wind_speed.as_ref().unwrap().iter().all(|&v| v == 5.144444));
+        assert!(r
+            .wind_speed
+            .as_ref()
+            .unwrap()
+            .iter()
+            .all(|&v| v == 5.144444));
         let wa = r.wind_angle.as_ref().unwrap();
         assert_eq!(wa[0], 356.0);
         assert_eq!(wa[8], 0.0);
@@ -897,7 +902,14 @@ mod tests {
         let e = parse(GAP, &NmeaOptions::default()).unwrap_err();
         let msg = e.to_string();
         assert!(
-            matches!(e, NmeaError::Gap { line: 40, sentence: "ROT", .. }),
+            matches!(
+                e,
+                NmeaError::Gap {
+                    line: 40,
+                    sentence: "ROT",
+                    ..
+                }
+            ),
             "{msg}"
         );
         assert!(
@@ -939,16 +951,21 @@ mod tests {
 
     #[test]
     fn clear_errors() {
-        let e = parse("$GPZDA,120000.00,14,06,2024,00,00*62\n", &NmeaOptions::default())
-            .unwrap_err()
-            .to_string();
+        let e = parse(
+            "$GPZDA,120000.00,14,06,2024,00,00*62\n",
+            &NmeaOptions::default(),
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("at least 2") && e.contains("--nmea-rate"), "{e}");
         let no_rsa: String = TRIAL
             .lines()
             .filter(|l| !l.contains("RSA"))
             .map(|l| format!("{l}\n"))
             .collect();
-        let e = parse(&no_rsa, &NmeaOptions::default()).unwrap_err().to_string();
+        let e = parse(&no_rsa, &NmeaOptions::default())
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("no valid RSA sentence"), "{e}");
         let e = parse("$HEROT,abc,A*65\n", &NmeaOptions::default())
             .unwrap_err()

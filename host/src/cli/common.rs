@@ -1,0 +1,342 @@
+//! Argument groups and helpers shared by every subcommand: reading records and models,
+//! JSON summaries, seeds, progress bars and the bad-input marker behind exit code 2.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use clap::{Args, ValueEnum};
+use serde::Serialize;
+use yawcast::data::{self, Columns, Record};
+use yawcast::model::Model;
+use yawcast::nmea::{self, Clock, NmeaOptions};
+
+/// Marks an error as caused by the user's input (exit code 2).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct BadInput(pub String);
+
+/// Wraps any error as bad input, keeping its message.
+pub fn bad<E: std::fmt::Display>(e: E) -> anyhow::Error {
+    anyhow::Error::new(BadInput(e.to_string()))
+}
+
+/// Whether an error chain is bad input: our marker, or a data/model/blob error from the library.
+pub fn is_bad_input(err: &anyhow::Error) -> bool {
+    err.chain().any(|c| {
+        c.is::<BadInput>()
+            || c.is::<data::DataError>()
+            || c.is::<nmea::NmeaError>()
+            || c.is::<yawcast::model::ModelError>()
+            || c.is::<yawcast_shared::blob::BlobError>()
+            || c.is::<yawcast_shared::model::ModelError>()
+            || c.is::<serde_json::Error>()
+            || c.is::<toml::de::Error>()
+            || c.is::<clap::Error>()
+    })
+}
+
+/// Angle unit of CSV columns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum AngleUnit {
+    /// Degrees.
+    Deg,
+    /// Radians.
+    Rad,
+}
+
+/// Rate unit of the yaw-rate column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RateUnit {
+    /// Degrees per second.
+    Degps,
+    /// Radians per second.
+    Radps,
+}
+
+/// File format of a record.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    /// By extension (`.nmea`, `.log`, `.txt` → NMEA) and content (a `$` sentence first).
+    Auto,
+    /// Measurement CSV.
+    Csv,
+    /// NMEA 0183 log.
+    Nmea,
+}
+
+/// How to read record files: CSV column names and units, NMEA clock and grid.
+#[derive(Debug, Clone, Args)]
+#[command(next_help_heading = "Reading records (CSV columns, NMEA logs)")]
+pub struct ReadArgs {
+    /// File format of --data/--validate/--reference files.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub format: Format,
+    /// CSV column holding time (s).
+    #[arg(long, value_name = "NAME", default_value = "t_s")]
+    pub col_time: String,
+    /// CSV column holding the commanded pod/rudder angle.
+    #[arg(long, value_name = "NAME", default_value = "delta_deg")]
+    pub col_delta: String,
+    /// CSV column holding the yaw rate.
+    #[arg(long, value_name = "NAME", default_value = "r_degps")]
+    pub col_rate: String,
+    /// CSV column holding the heading (optional column).
+    #[arg(long, value_name = "NAME", default_value = "psi_deg")]
+    pub col_heading: String,
+    /// CSV column holding the speed over ground in m/s (optional column).
+    #[arg(long, value_name = "NAME", default_value = "u_mps")]
+    pub col_speed: String,
+    /// CSV column holding the relative wind speed in m/s (optional column).
+    #[arg(long, value_name = "NAME", default_value = "wind_speed_mps")]
+    pub col_wind_speed: String,
+    /// CSV column holding the relative wind angle from the bow (optional column).
+    #[arg(long, value_name = "NAME", default_value = "wind_angle_deg")]
+    pub col_wind_angle: String,
+    /// Unit of the CSV angle columns (angle, heading, wind angle).
+    #[arg(long, value_enum, default_value = "deg")]
+    pub angle_unit: AngleUnit,
+    /// Unit of the CSV yaw-rate column.
+    #[arg(long, value_enum, default_value = "degps")]
+    pub rate_unit: RateUnit,
+    /// NMEA logs without a ZDA/RMC clock: the rate (Hz) at which ROT sentences arrive.
+    #[arg(long, value_name = "HZ")]
+    pub nmea_rate: Option<f64>,
+    /// NMEA logs: grid step (s) to resample onto [default: the usual ROT spacing].
+    #[arg(long, value_name = "SECONDS")]
+    pub nmea_ts: Option<f64>,
+    /// NMEA logs: longest tolerated hole in a channel (s) [default: max(2 grid steps, 2.5 × its usual spacing)].
+    #[arg(long, value_name = "SECONDS")]
+    pub max_gap: Option<f64>,
+    /// NMEA logs: drop sentences with a bad checksum instead of failing.
+    #[arg(long)]
+    pub skip_bad_checksums: bool,
+}
+
+impl Default for ReadArgs {
+    fn default() -> Self {
+        ReadArgs {
+            format: Format::Auto,
+            col_time: "t_s".into(),
+            col_delta: "delta_deg".into(),
+            col_rate: "r_degps".into(),
+            col_heading: "psi_deg".into(),
+            col_speed: "u_mps".into(),
+            col_wind_speed: "wind_speed_mps".into(),
+            col_wind_angle: "wind_angle_deg".into(),
+            angle_unit: AngleUnit::Deg,
+            rate_unit: RateUnit::Degps,
+            nmea_rate: None,
+            nmea_ts: None,
+            max_gap: None,
+            skip_bad_checksums: false,
+        }
+    }
+}
+
+impl ReadArgs {
+    /// The CSV column mapping.
+    pub fn columns(&self) -> Columns {
+        let rad = 180.0 / std::f64::consts::PI;
+        Columns {
+            t: self.col_time.clone(),
+            u: self.col_delta.clone(),
+            y: self.col_rate.clone(),
+            psi: self.col_heading.clone(),
+            speed: self.col_speed.clone(),
+            wind_speed: self.col_wind_speed.clone(),
+            wind_angle: self.col_wind_angle.clone(),
+            angle_scale: match self.angle_unit {
+                AngleUnit::Deg => 1.0,
+                AngleUnit::Rad => rad,
+            },
+            rate_scale: match self.rate_unit {
+                RateUnit::Degps => 1.0,
+                RateUnit::Radps => rad,
+            },
+        }
+    }
+
+    /// The NMEA options.
+    pub fn nmea(&self) -> NmeaOptions {
+        NmeaOptions {
+            clock: self.nmea_rate.map_or(Clock::Log, Clock::Rate),
+            ts: self.nmea_ts,
+            max_gap: self.max_gap,
+            skip_bad_checksums: self.skip_bad_checksums,
+        }
+    }
+
+    /// Reads one record file (CSV or NMEA).
+    ///
+    /// Errors name the file, row/line and column/sentence; they count as bad input.
+    pub fn read(&self, path: &Path) -> Result<Record> {
+        let bytes = std::fs::read(path)
+            .map_err(|e| bad(format!("{}: cannot read: {e}", path.display())))?;
+        let text = String::from_utf8_lossy(&bytes);
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        let is_nmea = match self.format {
+            Format::Nmea => true,
+            Format::Csv => false,
+            Format::Auto => {
+                matches!(ext.as_str(), "nmea" | "log" | "txt" | "nmea0183")
+                    || (ext != "csv" && nmea::looks_like_nmea(&text))
+            }
+        };
+        if is_nmea {
+            Ok(nmea::parse_nmea(&text, path, &name, &self.nmea())?)
+        } else {
+            Ok(data::parse_csv(&text, path, &name, &self.columns())?)
+        }
+    }
+}
+
+/// `--json FILE`: where the machine-readable summary goes.
+#[derive(Debug, Clone, Args)]
+pub struct JsonArg {
+    /// Write a machine-readable summary (stable field names) to this file.
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+}
+
+impl JsonArg {
+    /// Writes `value` as pretty JSON, atomically, when `--json` was given.
+    pub fn write<T: Serialize>(&self, value: &T) -> Result<()> {
+        if let Some(p) = &self.json {
+            write_json(p, value)?;
+        }
+        Ok(())
+    }
+}
+
+/// Writes `value` as pretty JSON to `path`, atomically.
+pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<()> {
+    let mut bytes = serde_json::to_vec_pretty(value).context("serialising the JSON summary")?;
+    bytes.push(b'\n');
+    data::write_atomic(path, &bytes)
+        .with_context(|| format!("writing the JSON summary {}", path.display()))
+}
+
+/// `--seed N`: the seed of every random choice; drawn and printed when not given.
+#[derive(Debug, Clone, Args)]
+pub struct SeedArg {
+    /// Seed of every random choice (printed; the same seed gives the same result).
+    #[arg(long, value_name = "N")]
+    pub seed: Option<u64>,
+}
+
+#[allow(dead_code)] // wired into the random commands as their libraries land
+impl SeedArg {
+    /// The seed to use: the given one, or one drawn from the clock. Printed on stderr.
+    pub fn resolve(&self) -> u64 {
+        let seed = self.seed.unwrap_or_else(|| {
+            let nanos = std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map(|d| d.as_nanos() as u64)
+                .unwrap_or(0);
+            (nanos ^ (u64::from(std::process::id()) << 32)) % 1_000_000
+        });
+        eprintln!("seed {seed} (rerun with --seed {seed} to repeat)");
+        seed
+    }
+}
+
+/// A progress bar on stderr (hidden when stderr is not a terminal).
+#[allow(dead_code)] // wired into the long commands as their libraries land
+pub fn progress(len: u64, msg: &str) -> indicatif::ProgressBar {
+    let pb = indicatif::ProgressBar::with_draw_target(
+        Some(len),
+        indicatif::ProgressDrawTarget::stderr(),
+    );
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "{msg:>12} [{bar:30}] {pos}/{len} {elapsed_precise} {wide_msg:.dim}",
+    ) {
+        pb.set_style(style.progress_chars("=> "));
+    }
+    pb.set_message(msg.to_string());
+    pb
+}
+
+/// Reads a model: a `.postcard` blob (with its `.json` twin beside it, whose f64 numbers are
+/// used when they agree with the blob), or a `.json` twin directly.
+pub fn read_model(path: &Path) -> Result<Model> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| bad(format!("{}: cannot read the model: {e}", path.display())))?;
+    let is_json = path.extension().is_some_and(|e| e == "json");
+    if is_json {
+        return model_from_json(&bytes, path);
+    }
+    let spec = yawcast_shared::blob::decode_blob(&bytes)
+        .map_err(|e| bad(format!("{}: {e}", path.display())))?;
+    let from_blob = Model::from_spec(&spec).map_err(|e| bad(format!("{}: {e}", path.display())))?;
+    let twin = path.with_extension("json");
+    if let Ok(tb) = std::fs::read(&twin) {
+        if let Ok(m) = model_from_json(&tb, &twin) {
+            // The twin must describe the same model as the blob (to f32 precision).
+            if m.to_spec().ok().as_ref() == Some(&spec) {
+                return Ok(m);
+            }
+            eprintln!(
+                "warning: {} does not match {}; using the blob's f32 numbers",
+                twin.display(),
+                path.display()
+            );
+        }
+    }
+    Ok(from_blob)
+}
+
+fn model_from_json(bytes: &[u8], path: &Path) -> Result<Model> {
+    let v: serde_json::Value = serde_json::from_slice(bytes)
+        .map_err(|e| bad(format!("{}: not JSON: {e}", path.display())))?;
+    // The twin may hold the model at the top level or under "model".
+    let inner = v.get("model").cloned().unwrap_or(v);
+    let m: Model = serde_json::from_value(inner)
+        .map_err(|e| bad(format!("{}: not a yawcast model: {e}", path.display())))?;
+    m.validate()
+        .map_err(|e| bad(format!("{}: {e}", path.display())))?;
+    Ok(m)
+}
+
+/// Parses `--horizons 1,5,10,20,sim`.
+pub fn parse_horizons(s: &str) -> Result<Vec<yawcast::predict::Horizon>> {
+    s.split(',')
+        .map(|p| {
+            yawcast::predict::Horizon::parse(p).ok_or_else(|| {
+                bad(format!(
+                    "--horizons: `{p}` is not a horizon (a whole number ≥ 1 or `sim`)"
+                ))
+            })
+        })
+        .collect()
+}
+
+/// Checks a record against a model (sample time, length).
+pub fn check_record_for_model(rec: &Record, model: &Model, path: &Path) -> Result<()> {
+    let rel = (rec.ts - model.ts).abs() / model.ts;
+    if rel > 1e-3 {
+        return Err(bad(format!(
+            "{}: sampled every {} s, the model every {} s (resample the record or identify a model at {} s)",
+            path.display(),
+            rec.ts,
+            model.ts,
+            rec.ts
+        )));
+    }
+    let needed = 4 * model.n + 2;
+    if rec.len() < needed {
+        return Err(bad(format!(
+            "{}: {} samples, at least {needed} needed for a model of order {}",
+            path.display(),
+            rec.len(),
+            model.n
+        )));
+    }
+    Ok(())
+}

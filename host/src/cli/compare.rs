@@ -1,0 +1,142 @@
+//! `yawcast compare`: fit % per record and horizon, measured vs predicted series.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::Args;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use yawcast::predict::{self, Horizon};
+
+use super::common::{check_record_for_model, parse_horizons, read_model, JsonArg, ReadArgs};
+
+/// Arguments of `yawcast compare`.
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// The model (`.postcard` blob with its `.json` twin beside it, or the `.json` twin).
+    #[arg(long, value_name = "FILE")]
+    pub model: PathBuf,
+    /// Measured records (CSV or NMEA); repeatable.
+    #[arg(long, value_name = "FILE", required = true)]
+    pub data: Vec<PathBuf>,
+    /// Horizons: whole numbers of steps and/or `sim` (pure simulation).
+    #[arg(long, value_name = "LIST", default_value = "1,5,10,20,sim")]
+    pub horizons: String,
+    /// Directory for the measured-vs-predicted series (one CSV per record).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    pub json: JsonArg,
+    #[command(flatten)]
+    pub read: ReadArgs,
+}
+
+/// One record's result.
+#[derive(Debug, Serialize)]
+pub struct RecordFit {
+    /// Record name (file stem).
+    pub name: String,
+    /// Samples.
+    pub samples: usize,
+    /// Fit % keyed by horizon ("1", "5", …, "sim").
+    pub fit: BTreeMap<String, f64>,
+}
+
+/// The JSON summary of `compare`.
+#[derive(Debug, Serialize)]
+pub struct CompareSummary {
+    /// Always "compare".
+    pub command: &'static str,
+    /// Model file.
+    pub model: String,
+    /// Horizons, as keys.
+    pub horizons: Vec<String>,
+    /// Per-record fits.
+    pub records: Vec<RecordFit>,
+    /// Mean fit over records, keyed by horizon.
+    pub mean_fit: BTreeMap<String, f64>,
+}
+
+/// Runs `compare`.
+pub fn run(args: &CompareArgs) -> Result<()> {
+    let model = read_model(&args.model)?;
+    let horizons = parse_horizons(&args.horizons)?;
+    let mut records = Vec::new();
+    for p in &args.data {
+        let rec = args.read.read(p)?;
+        check_record_for_model(&rec, &model, p)?;
+        records.push(rec);
+    }
+    let mut out = Vec::new();
+    let mut series = Vec::new();
+    for rec in &records {
+        let x0 = predict::estimate_x0(&model, rec);
+        let mut fit = BTreeMap::new();
+        let mut cols = Vec::new();
+        for &h in &horizons {
+            let yhat = predict::predict(&model, rec, &x0, h);
+            fit.insert(h.key(), predict::fit(&rec.y, &yhat));
+            cols.push((h, yhat));
+        }
+        series.push(cols);
+        out.push(RecordFit {
+            name: rec.name.clone(),
+            samples: rec.len(),
+            fit,
+        });
+    }
+    let mut mean_fit = BTreeMap::new();
+    for h in &horizons {
+        let k = h.key();
+        let m = out.iter().map(|r| r.fit[&k]).sum::<f64>() / out.len() as f64;
+        mean_fit.insert(k, m);
+    }
+    print_table(&horizons, &out, &mean_fit);
+    if let Some(dir) = &args.out {
+        for (rec, cols) in records.iter().zip(&series) {
+            let mut s = String::from("t_s,delta_deg,r_degps");
+            for (h, _) in cols {
+                s.push_str(&format!(",rhat_{}_degps", h.key()));
+            }
+            s.push('\n');
+            for i in 0..rec.len() {
+                s.push_str(&format!("{},{},{}", rec.t[i], rec.u[i], rec.y[i]));
+                for (_, y) in cols {
+                    s.push_str(&format!(",{}", y[i]));
+                }
+                s.push('\n');
+            }
+            let p = dir.join(format!("{}.compare.csv", rec.name));
+            yawcast::data::write_atomic(&p, s.as_bytes())?;
+        }
+        println!("series written to {}", dir.display());
+    }
+    args.json.write(&CompareSummary {
+        command: "compare",
+        model: args.model.display().to_string(),
+        horizons: horizons.iter().map(Horizon::key).collect(),
+        records: out,
+        mean_fit,
+    })
+}
+
+fn print_table(horizons: &[Horizon], rows: &[RecordFit], mean: &BTreeMap<String, f64>) {
+    let name_w = rows.iter().map(|r| r.name.len()).max().unwrap_or(6).max(6);
+    print!("{:<name_w$}", "record");
+    for h in horizons {
+        print!(" {:>8}", format!("fit@{}", h.key()));
+    }
+    println!();
+    for r in rows {
+        print!("{:<name_w$}", r.name);
+        for h in horizons {
+            print!(" {:>8.2}", r.fit[&h.key()]);
+        }
+        println!();
+    }
+    print!("{:<name_w$}", "mean");
+    for h in horizons {
+        print!(" {:>8.2}", mean[&h.key()]);
+    }
+    println!();
+}

@@ -1,0 +1,78 @@
+//! The command line: one `Cli` with a subcommand per tool, and the glue to the library.
+
+use anyhow::Result;
+use clap::{Parser, Subcommand};
+
+pub mod common;
+pub mod compare;
+
+/// yawcast — ship trials to a yaw-rate predictor that runs on the ship's controller.
+///
+/// Exit codes: 0 success, 2 bad input (unreadable or invalid files, bad arguments, data
+/// errors), 1 any other failure. The first line of an error names its cause.
+#[derive(Debug, Parser)]
+#[command(name = "yawcast", version, about, long_about = None, max_term_width = 100)]
+pub struct Cli {
+    /// The tool to run.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Every tool.
+#[allow(clippy::large_enum_variant)] // parsed once; boxing buys nothing
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Simulate records of the built-in (or your) ship: identification inputs, trials, manoeuvres.
+    Simulate(Pending),
+    /// Identify a model from records (prediction-error method), or select the order.
+    Identify(Pending),
+    /// Tune the regularisation (λ, R) with the genetic algorithm, scored on trial records.
+    Tune(Pending),
+    /// Combine several models: plain average, covariance-weighted merge, multi-record PEM.
+    Average(Pending),
+    /// Export a model as the firmware blob (+ JSON twin), checked through the firmware predictor.
+    Export(Pending),
+    /// Fit % of a model on records per horizon; measured vs predicted series.
+    Compare(compare::CompareArgs),
+    /// Which physical effect is missing from the model? Evidence for every effect, and a verdict.
+    Diagnose(Pending),
+    /// Add an effect to a model, re-identify, and show the error before and after.
+    Augment(Pending),
+    /// The whole story on the built-in ship with a hidden effect, ending in report.html.
+    Demo(Pending),
+    /// Hardware in the loop: the simulator sails, the firmware (QEMU or a board) predicts.
+    Hil(Pending),
+}
+
+/// Arguments of a tool not wired into this build yet.
+#[derive(Debug, clap::Args)]
+pub struct Pending {
+    /// Arguments.
+    #[arg(trailing_var_arg = true, allow_hyphen_values = true, hide = true)]
+    pub rest: Vec<String>,
+}
+
+impl Command {
+    fn name(&self) -> &'static str {
+        match self {
+            Command::Simulate(_) => "simulate",
+            Command::Identify(_) => "identify",
+            Command::Tune(_) => "tune",
+            Command::Average(_) => "average",
+            Command::Export(_) => "export",
+            Command::Compare(_) => "compare",
+            Command::Diagnose(_) => "diagnose",
+            Command::Augment(_) => "augment",
+            Command::Demo(_) => "demo",
+            Command::Hil(_) => "hil",
+        }
+    }
+}
+
+/// Runs the parsed command line.
+pub fn run(cli: Cli) -> Result<()> {
+    match &cli.command {
+        Command::Compare(a) => compare::run(a),
+        other => anyhow::bail!("`yawcast {}` is not available in this build", other.name()),
+    }
+}

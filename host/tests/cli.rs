@@ -1,0 +1,321 @@
+//! CLI contract tests: they run the built `yawcast` binary and pin exit codes, messages,
+//! file formats and JSON field names.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_yawcast"))
+}
+
+/// A fresh scratch directory per test.
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("yawcast-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn run(args: &[&str]) -> Output {
+    bin().args(args).output().expect("runs the binary")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn code(o: &Output) -> i32 {
+    o.status.code().unwrap_or(-1)
+}
+
+fn data_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data")
+}
+
+/// A small stable 2nd-order model as a JSON twin.
+fn write_model(dir: &Path) -> PathBuf {
+    let p = dir.join("m.json");
+    std::fs::write(
+        &p,
+        r#"{"n":2,"ts":0.5,"a":[-0.2,0.7],"b":[0.01,0.02],"k":[0.5,0.2],"effects":[]}"#,
+    )
+    .unwrap();
+    p
+}
+
+/// A measurement CSV with `n` rows and a PRBS-like input.
+fn csv_text(n: usize, ts: f64) -> String {
+    let mut s = String::from("t_s,delta_deg,r_degps\n");
+    let mut y = 0.0;
+    for i in 0..n {
+        let u = if (i / 7) % 2 == 0 { 10.0 } else { -10.0 };
+        y = 0.9 * y + 0.01 * u;
+        s.push_str(&format!("{},{},{:.6}\n", i as f64 * ts, u, y));
+    }
+    s
+}
+
+#[test]
+fn help_lists_every_subcommand() {
+    let o = run(&["--help"]);
+    assert_eq!(code(&o), 0);
+    let out = stdout(&o);
+    for c in [
+        "simulate", "identify", "tune", "average", "export", "compare", "diagnose", "augment",
+        "demo", "hil",
+    ] {
+        assert!(
+            out.lines().any(|l| l.trim_start().starts_with(c)),
+            "`{c}` missing from --help:\n{out}"
+        );
+    }
+}
+
+#[test]
+fn bad_arguments_exit_2() {
+    let o = run(&["compare", "--no-such-flag"]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    let o = run(&["no-such-command"]);
+    assert_eq!(code(&o), 2);
+}
+
+#[test]
+fn missing_file_is_bad_input_naming_it() {
+    let d = scratch("missing");
+    let m = write_model(&d);
+    let o = run(&[
+        "compare",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        "/nonexistent/trial.csv",
+    ]);
+    assert_eq!(code(&o), 2);
+    let e = stderr(&o);
+    assert!(e.starts_with("error: "), "{e}");
+    assert!(e.contains("/nonexistent/trial.csv"), "{e}");
+}
+
+#[test]
+fn csv_errors_name_file_row_and_column() {
+    let d = scratch("csverr");
+    let m = write_model(&d);
+    let cases: [(&str, String, &[&str]); 3] = [
+        (
+            "missing.csv",
+            "t_s,delta_deg\n0,1\n0.5,1\n".into(),
+            &["missing.csv", "missing column `r_degps`"],
+        ),
+        (
+            "nan.csv",
+            csv_text(40, 0.5).replacen("\n2.5,", "\n2.5,NaN_", 1),
+            &["nan.csv", "row 6", "delta_deg"],
+        ),
+        (
+            "nonuniform.csv",
+            csv_text(40, 0.5).replacen("\n3,", "\n3.2,", 1),
+            &["nonuniform.csv", "row 7", "uniform"],
+        ),
+    ];
+    for (name, text, needles) in cases {
+        let f = d.join(name);
+        std::fs::write(&f, text).unwrap();
+        let o = run(&[
+            "compare",
+            "--model",
+            m.to_str().unwrap(),
+            "--data",
+            f.to_str().unwrap(),
+        ]);
+        let e = stderr(&o);
+        assert_eq!(code(&o), 2, "{name}: {e}");
+        let first = e.lines().next().unwrap_or("");
+        for n in needles {
+            assert!(first.contains(n), "{name}: `{n}` not in first line: {e}");
+        }
+    }
+}
+
+#[test]
+fn custom_columns_and_units() {
+    let d = scratch("cols");
+    let m = write_model(&d);
+    // Same data in radians and rad/s under other names: the fit must be identical.
+    let deg = csv_text(60, 0.5);
+    let mut rad = String::from("time,rudder,rot\n");
+    for l in deg.lines().skip(1) {
+        let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+        rad.push_str(&format!(
+            "{},{},{}\n",
+            v[0],
+            v[1].to_radians(),
+            v[2].to_radians()
+        ));
+    }
+    std::fs::write(d.join("deg.csv"), deg).unwrap();
+    std::fs::write(d.join("rad.csv"), rad).unwrap();
+    let j1 = d.join("deg.json");
+    let j2 = d.join("rad.json");
+    let o = run(&[
+        "compare",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        d.join("deg.csv").to_str().unwrap(),
+        "--json",
+        j1.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let o = run(&[
+        "compare",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        d.join("rad.csv").to_str().unwrap(),
+        "--col-time",
+        "time",
+        "--col-delta",
+        "rudder",
+        "--col-rate",
+        "rot",
+        "--angle-unit",
+        "rad",
+        "--rate-unit",
+        "radps",
+        "--json",
+        j2.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let a: serde_json::Value = serde_json::from_slice(&std::fs::read(j1).unwrap()).unwrap();
+    let b: serde_json::Value = serde_json::from_slice(&std::fs::read(j2).unwrap()).unwrap();
+    for h in ["1", "5", "10", "20", "sim"] {
+        let fa = a["mean_fit"][h].as_f64().unwrap();
+        let fb = b["mean_fit"][h].as_f64().unwrap();
+        assert!((fa - fb).abs() < 1e-6, "{h}: {fa} vs {fb}");
+    }
+    // Pinned field names of the compare summary.
+    assert_eq!(a["command"], "compare");
+    assert!(a["records"][0]["name"].is_string());
+    assert!(a["records"][0]["samples"].is_u64());
+    assert!(a["records"][0]["fit"]["5"].is_f64());
+}
+
+#[test]
+fn nmea_logs_are_read_and_their_errors_named() {
+    let d = scratch("nmea");
+    let p = d.join("m.json");
+    std::fs::write(
+        &p,
+        r#"{"n":2,"ts":0.5,"a":[-0.2,0.7],"b":[0.01,0.02],"k":[0.5,0.2],"effects":[]}"#,
+    )
+    .unwrap();
+    let log = data_dir().join("trial.nmea");
+    let o = run(&[
+        "compare",
+        "--model",
+        p.to_str().unwrap(),
+        "--data",
+        log.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(stdout(&o).contains("trial"), "{}", stdout(&o));
+
+    let bad = data_dir().join("trial-bad-checksum.nmea");
+    let o = run(&[
+        "compare",
+        "--model",
+        p.to_str().unwrap(),
+        "--data",
+        bad.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 2);
+    assert!(
+        stderr(&o).contains("line 49: bad checksum"),
+        "{}",
+        stderr(&o)
+    );
+
+    let gap = data_dir().join("trial-gap.nmea");
+    let o = run(&[
+        "compare",
+        "--model",
+        p.to_str().unwrap(),
+        "--data",
+        gap.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 2);
+    assert!(
+        stderr(&o).contains("gap of 3.50 s in ROT (rate of turn) after 12:00:03.50"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn model_and_data_must_agree() {
+    let d = scratch("mismatch");
+    let m = write_model(&d);
+    let f = d.join("ts1.csv");
+    std::fs::write(&f, csv_text(60, 1.0)).unwrap();
+    let o = run(&[
+        "compare",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        f.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 2);
+    assert!(stderr(&o).contains("sampled every 1 s, the model every 0.5 s"));
+    let bad_model = d.join("bad.json");
+    std::fs::write(
+        &bad_model,
+        r#"{"n":2,"ts":0.5,"a":[1.0],"b":[0,0],"k":[0,0]}"#,
+    )
+    .unwrap();
+    let o = run(&[
+        "compare",
+        "--model",
+        bad_model.to_str().unwrap(),
+        "--data",
+        f.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 2);
+    assert!(stderr(&o).contains("bad.json"), "{}", stderr(&o));
+}
+
+#[test]
+fn failed_run_leaves_no_partial_output() {
+    let d = scratch("atomic");
+    let m = write_model(&d);
+    let good = d.join("good.csv");
+    std::fs::write(&good, csv_text(60, 0.5)).unwrap();
+    let badf = d.join("bad.csv");
+    std::fs::write(&badf, "t_s,delta_deg,r_degps\n0,1,x\n").unwrap();
+    let json = d.join("out.json");
+    let o = run(&[
+        "compare",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        good.to_str().unwrap(),
+        "--data",
+        badf.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+        "--out",
+        d.join("series").to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 2);
+    assert!(!json.exists());
+    assert!(!d.join("series").exists());
+    let leftovers: Vec<_> = std::fs::read_dir(&d)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty());
+}
