@@ -6,3 +6,4 @@ pub mod data;
 pub mod model;
 pub mod nmea;
 pub mod predict;
+pub mod report;
