@@ -1,0 +1,686 @@
+//! Hardware in the loop: the firmware predicts while the host feeds it measurements.
+//!
+//! The firmware runs either in QEMU (`-machine netduinoplus2`, USART1 on a local TCP port)
+//! or on a real STM32F405 board behind a serial device. Each sample goes to it as a
+//! `Measurement`; a `PredictRequest` brings back ŷ(t+1|t) … ŷ(t+H|t). The host runs the same
+//! model through the firmware library natively ([`NativePredictor`]) and compares every
+//! predicted value bit for bit.
+//!
+//! ```
+//! use yawcast::hil::NativePredictor;
+//! use yawcast_shared::model::{ModelSpec, Units};
+//! let m = ModelSpec::new(2, 1.0, &[-0.25, 0.5], &[0.5, 0.25], &[0.5, 0.125],
+//!                        Units::default(), &[]).unwrap();
+//! let mut p = NativePredictor::new(&m).unwrap();
+//! p.update(1.0, 2.0, None);
+//! let mut out = [0.0f32; 3];
+//! p.predict(&mut out, &[2.0, 0.0]).unwrap();
+//! assert_eq!(out, [1.5, 1.5, 0.375]);
+//! ```
+
+use std::io::{Read, Write};
+use std::net::{TcpListener, TcpStream};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use thiserror::Error;
+use yawcast_firmware::{Predictor, PredictorError};
+use yawcast_shared::blob::{encode_blob, MAX_BLOB_LEN};
+use yawcast_shared::model::ModelSpec;
+use yawcast_shared::wire::{
+    DeviceMessage, Feed, FrameAccumulator, FutureInputs, HostMessage, MAX_FRAME_LEN,
+};
+
+use crate::data::Record;
+
+/// The thumb target of the firmware.
+pub const THUMB_TARGET: &str = "thumbv7em-none-eabihf";
+
+/// Environment variable naming a prebuilt firmware ELF.
+pub const ELF_VAR: &str = "YAWCAST_FW_ELF";
+
+/// How to build the firmware ELF.
+pub const BUILD_HINT: &str = "build it with `rustup target add thumbv7em-none-eabihf && \
+     cargo fw-build` (or point YAWCAST_FW_ELF at an ELF)";
+
+/// Errors of the hardware-in-the-loop link.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum HilError {
+    /// QEMU is not installed.
+    #[error("qemu-system-arm is not installed (apt-get install -y --no-install-recommends qemu-system-arm)")]
+    NoQemu,
+    /// No firmware ELF was found.
+    #[error("no firmware ELF found (looked in {looked}); {BUILD_HINT}")]
+    NoElf {
+        /// Places looked at.
+        looked: String,
+    },
+    /// Starting or talking to the device failed.
+    #[error("{0}")]
+    Link(String),
+    /// The device answered something unexpected.
+    #[error("device: expected {expected}, got {got}")]
+    Protocol {
+        /// What we waited for.
+        expected: &'static str,
+        /// What came.
+        got: String,
+    },
+    /// The model cannot run on the firmware.
+    #[error("the firmware cannot run this model: {0}")]
+    Model(String),
+    /// The firmware library refused a step.
+    #[error("firmware predictor: {0}")]
+    Predictor(#[from] PredictorError),
+}
+
+/// The firmware predictor run natively, for any order 2..=8.
+#[derive(Debug, Clone)]
+pub enum NativePredictor {
+    /// Order 2.
+    N2(Predictor<2>),
+    /// Order 3.
+    N3(Predictor<3>),
+    /// Order 4.
+    N4(Predictor<4>),
+    /// Order 5.
+    N5(Predictor<5>),
+    /// Order 6.
+    N6(Predictor<6>),
+    /// Order 7.
+    N7(Predictor<7>),
+    /// Order 8.
+    N8(Predictor<8>),
+}
+
+macro_rules! each {
+    ($s:expr, $p:ident => $e:expr) => {
+        match $s {
+            NativePredictor::N2($p) => $e,
+            NativePredictor::N3($p) => $e,
+            NativePredictor::N4($p) => $e,
+            NativePredictor::N5($p) => $e,
+            NativePredictor::N6($p) => $e,
+            NativePredictor::N7($p) => $e,
+            NativePredictor::N8($p) => $e,
+        }
+    };
+}
+
+impl NativePredictor {
+    /// A predictor in the zero state for `spec`.
+    ///
+    /// # Errors
+    /// [`HilError::Predictor`] when the firmware library refuses the model.
+    pub fn new(spec: &ModelSpec) -> Result<NativePredictor, HilError> {
+        Ok(match spec.order {
+            2 => NativePredictor::N2(Predictor::new(spec)?),
+            3 => NativePredictor::N3(Predictor::new(spec)?),
+            4 => NativePredictor::N4(Predictor::new(spec)?),
+            5 => NativePredictor::N5(Predictor::new(spec)?),
+            6 => NativePredictor::N6(Predictor::new(spec)?),
+            7 => NativePredictor::N7(Predictor::new(spec)?),
+            8 => NativePredictor::N8(Predictor::new(spec)?),
+            n => return Err(HilError::Model(format!("order {n} is outside 2..=8"))),
+        })
+    }
+
+    /// One measurement update (`y` NaN when missing).
+    pub fn update(&mut self, u: f32, y: f32, psi: Option<f32>) {
+        each!(self, p => { p.update_with_heading(u, y, psi); })
+    }
+
+    /// ŷ(t+1|t) … ŷ(t+H|t) into `out` (H = `out.len()`), `future_u` = u(t+1) … u(t+H−1).
+    ///
+    /// # Errors
+    /// [`HilError::Predictor`] for a bad horizon, too few inputs or a non-finite prediction.
+    pub fn predict(&self, out: &mut [f32], future_u: &[f32]) -> Result<(), HilError> {
+        Ok(each!(self, p => p.predict_into(out, future_u))?)
+    }
+}
+
+/// The future commands u(t+1) … u(t+H−1) of a record (the last command repeated past the end).
+pub fn future_inputs(u: &[f32], t: usize, h: usize) -> Vec<f32> {
+    let last = u.last().copied().unwrap_or(0.0);
+    (1..h)
+        .map(|j| u.get(t + j).copied().unwrap_or(last))
+        .collect()
+}
+
+/// The record's channels as the firmware sees them (f32).
+#[derive(Debug, Clone)]
+pub struct F32Record {
+    /// Commands.
+    pub u: Vec<f32>,
+    /// Measured yaw rate.
+    pub y: Vec<f32>,
+    /// Measured heading, when logged.
+    pub psi: Option<Vec<f32>>,
+}
+
+impl F32Record {
+    /// Converts a record.
+    pub fn new(rec: &Record) -> F32Record {
+        let f = |v: &[f64]| v.iter().map(|x| *x as f32).collect::<Vec<_>>();
+        F32Record {
+            u: f(&rec.u),
+            y: f(&rec.y),
+            psi: rec.psi.as_deref().map(f),
+        }
+    }
+    fn psi(&self, t: usize) -> Option<f32> {
+        self.psi.as_ref().map(|p| p[t])
+    }
+}
+
+/// Runs the firmware library natively over a record: after each update, the H-step
+/// prediction. Returns `H` values per sample.
+///
+/// # Errors
+/// [`HilError`] when the model is refused or a prediction fails.
+pub fn native_run(spec: &ModelSpec, rec: &F32Record, h: usize) -> Result<Vec<Vec<f32>>, HilError> {
+    let mut p = NativePredictor::new(spec)?;
+    let mut out = Vec::with_capacity(rec.u.len());
+    for t in 0..rec.u.len() {
+        p.update(rec.u[t], rec.y[t], rec.psi(t));
+        let mut yhat = vec![0.0f32; h];
+        p.predict(&mut yhat, &future_inputs(&rec.u, t, h))?;
+        out.push(yhat);
+    }
+    Ok(out)
+}
+
+/// Where the firmware ELF may be: `$YAWCAST_FW_ELF`, then the usual build directories.
+pub fn elf_candidates(workspace: &Path) -> Vec<PathBuf> {
+    let mut v = Vec::new();
+    if let Some(p) = std::env::var_os(ELF_VAR) {
+        v.push(PathBuf::from(p));
+    }
+    for sub in ["target", "target/thumb"] {
+        v.push(
+            workspace
+                .join(sub)
+                .join(THUMB_TARGET)
+                .join("release")
+                .join("yawcast-fw"),
+        );
+    }
+    v
+}
+
+/// The first firmware ELF that exists.
+///
+/// # Errors
+/// [`HilError::NoElf`] naming the places looked at.
+pub fn find_elf(workspace: &Path) -> Result<PathBuf, HilError> {
+    let c = elf_candidates(workspace);
+    c.iter()
+        .find(|p| p.is_file())
+        .cloned()
+        .ok_or_else(|| HilError::NoElf {
+            looked: c
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
+        })
+}
+
+/// Whether `qemu-system-arm` can be run.
+pub fn qemu_available() -> bool {
+    Command::new("qemu-system-arm")
+        .arg("--version")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success())
+}
+
+trait Port: Read + Write + Send + std::fmt::Debug {}
+impl<T: Read + Write + Send + std::fmt::Debug> Port for T {}
+
+/// A firmware on the other end of a UART: QEMU or a board.
+#[derive(Debug)]
+pub struct Device {
+    port: Box<dyn Port>,
+    child: Option<Child>,
+    acc: FrameAccumulator,
+    rx: Vec<u8>,
+    rx_pos: usize,
+    tx: Vec<u8>,
+    /// The model order the firmware runs (from its banner; 0 when unknown).
+    pub order: u8,
+    /// Where QEMU's own output (defmt log) goes, when running under QEMU.
+    pub log: Option<PathBuf>,
+}
+
+impl Device {
+    /// Boots `elf` in QEMU and waits for the banner.
+    ///
+    /// # Errors
+    /// [`HilError::NoQemu`], or [`HilError::Link`] when QEMU does not come up.
+    pub fn qemu(elf: &Path) -> Result<Device, HilError> {
+        if !qemu_available() {
+            return Err(HilError::NoQemu);
+        }
+        let link = |e: String| HilError::Link(e);
+        let port = TcpListener::bind("127.0.0.1:0")
+            .and_then(|l| l.local_addr())
+            .map_err(|e| link(format!("no free local port: {e}")))?
+            .port();
+        let log = std::env::temp_dir().join(format!("yawcast-hil-qemu-{port}.log"));
+        let logf = std::fs::File::create(&log).map_err(|e| link(e.to_string()))?;
+        let logf2 = logf.try_clone().map_err(|e| link(e.to_string()))?;
+        let child = Command::new("qemu-system-arm")
+            .args([
+                "-machine",
+                "netduinoplus2",
+                "-nographic",
+                "-monitor",
+                "none",
+            ])
+            .args(["-semihosting-config", "enable=on,target=native"])
+            .arg("-serial")
+            .arg(format!("tcp:127.0.0.1:{port},server=on,wait=on"))
+            .arg("-kernel")
+            .arg(elf)
+            .stdin(Stdio::null())
+            .stdout(logf)
+            .stderr(logf2)
+            .spawn()
+            .map_err(|e| link(format!("starting qemu-system-arm: {e}")))?;
+        let mut child = Some(child);
+        let start = Instant::now();
+        let stream = loop {
+            match TcpStream::connect(("127.0.0.1", port)) {
+                Ok(s) => break s,
+                Err(e) if start.elapsed() > Duration::from_secs(20) => {
+                    if let Some(mut c) = child.take() {
+                        let _ = c.kill();
+                        let _ = c.wait();
+                    }
+                    return Err(link(format!(
+                        "QEMU did not open its UART on port {port}: {e}"
+                    )));
+                }
+                Err(_) => std::thread::sleep(Duration::from_millis(20)),
+            }
+        };
+        stream
+            .set_read_timeout(Some(Duration::from_secs(30)))
+            .map_err(|e| link(e.to_string()))?;
+        stream.set_nodelay(true).map_err(|e| link(e.to_string()))?;
+        let mut d = Device::over(Box::new(stream));
+        d.child = child;
+        d.log = Some(log);
+        d.expect_banner()?;
+        Ok(d)
+    }
+
+    /// Opens a serial device (already configured: `stty -F DEV 115200 raw -echo`), pings
+    /// the firmware and reads its order from a fresh banner if one arrives.
+    ///
+    /// # Errors
+    /// [`HilError::Link`] when the device cannot be opened or does not answer.
+    pub fn serial(path: &Path) -> Result<Device, HilError> {
+        let f = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(path)
+            .map_err(|e| HilError::Link(format!("{}: {e}", path.display())))?;
+        let mut d = Device::over(Box::new(f));
+        // Resynchronise with an empty frame, then ping.
+        d.tx.push(0);
+        d.send(&HostMessage::Ping)?;
+        loop {
+            match d.recv()? {
+                DeviceMessage::Pong => break,
+                DeviceMessage::Banner { order, .. } => d.order = order,
+                other => {
+                    return Err(HilError::Protocol {
+                        expected: "Pong",
+                        got: format!("{other:?}"),
+                    })
+                }
+            }
+        }
+        Ok(d)
+    }
+
+    fn over(port: Box<dyn Port>) -> Device {
+        Device {
+            port,
+            child: None,
+            acc: FrameAccumulator::new(),
+            rx: Vec::new(),
+            rx_pos: 0,
+            tx: Vec::new(),
+            order: 0,
+            log: None,
+        }
+    }
+
+    fn expect_banner(&mut self) -> Result<(), HilError> {
+        match self.recv()? {
+            DeviceMessage::Banner { order, .. } => {
+                self.order = order;
+                Ok(())
+            }
+            other => Err(HilError::Protocol {
+                expected: "Banner",
+                got: format!("{other:?}"),
+            }),
+        }
+    }
+
+    /// Queues a message.
+    ///
+    /// # Errors
+    /// [`HilError::Link`] when the message does not fit a frame.
+    pub fn send(&mut self, msg: &HostMessage<'_>) -> Result<(), HilError> {
+        let mut buf = [0u8; MAX_FRAME_LEN];
+        let frame = msg
+            .encode(&mut buf)
+            .map_err(|e| HilError::Link(format!("encoding a message: {e}")))?;
+        self.tx.extend_from_slice(frame);
+        Ok(())
+    }
+
+    /// Flushes what is queued and receives the next message.
+    ///
+    /// # Errors
+    /// [`HilError::Link`] on a closed link, a timeout or a bad frame.
+    pub fn recv(&mut self) -> Result<DeviceMessage, HilError> {
+        let link = |e: String| HilError::Link(e);
+        if !self.tx.is_empty() {
+            self.port
+                .write_all(&self.tx)
+                .and_then(|()| self.port.flush())
+                .map_err(|e| link(format!("UART write: {e}")))?;
+            self.tx.clear();
+        }
+        loop {
+            while self.rx_pos < self.rx.len() {
+                let b = self.rx[self.rx_pos];
+                self.rx_pos += 1;
+                match self.acc.push(b) {
+                    Feed::Pending => {}
+                    Feed::Frame(f) => {
+                        return DeviceMessage::decode(f)
+                            .map_err(|e| link(format!("device sent a bad message: {e}")));
+                    }
+                    Feed::Error(e) => return Err(link(format!("device sent a bad frame: {e}"))),
+                }
+            }
+            self.rx.resize(4096, 0);
+            self.rx_pos = 0;
+            match self.port.read(&mut self.rx) {
+                Ok(0) => return Err(link("UART closed".into())),
+                Ok(n) => self.rx.truncate(n),
+                Err(e) => return Err(link(format!("UART read: {e}"))),
+            }
+        }
+    }
+
+    /// Loads a model (as a blob); returns the CRC the device reports.
+    ///
+    /// # Errors
+    /// [`HilError::Model`] when the device refuses it.
+    pub fn load(&mut self, spec: &ModelSpec) -> Result<u32, HilError> {
+        if self.order != 0 && self.order != spec.order {
+            return Err(HilError::Model(format!(
+                "this firmware build runs models of order {}, the model has order {}",
+                self.order, spec.order
+            )));
+        }
+        let mut buf = [0u8; MAX_BLOB_LEN];
+        let blob = encode_blob(spec, &mut buf).map_err(|e| HilError::Model(e.to_string()))?;
+        self.send(&HostMessage::LoadModel(blob))?;
+        match self.recv()? {
+            DeviceMessage::ModelLoaded { crc, .. } => Ok(crc),
+            DeviceMessage::Error { code } => Err(HilError::Model(format!(
+                "the device refused the model (error {code:?})"
+            ))),
+            other => Err(HilError::Protocol {
+                expected: "ModelLoaded",
+                got: format!("{other:?}"),
+            }),
+        }
+    }
+
+    /// One measurement and the H-step prediction after it.
+    ///
+    /// # Errors
+    /// [`HilError`] when the device answers with an error or not at all.
+    pub fn step(
+        &mut self,
+        u: f32,
+        y: f32,
+        psi: Option<f32>,
+        future_u: &[f32],
+        h: usize,
+    ) -> Result<Vec<f32>, HilError> {
+        let fu: FutureInputs = future_u.iter().copied().take(h.saturating_sub(1)).collect();
+        self.send(&HostMessage::Measurement { u, y, psi })?;
+        self.send(&HostMessage::PredictRequest {
+            horizon: h as u8,
+            future_u: fu,
+        })?;
+        match self.recv()? {
+            DeviceMessage::Ack { .. } => {}
+            other => {
+                return Err(HilError::Protocol {
+                    expected: "Ack",
+                    got: format!("{other:?}"),
+                })
+            }
+        }
+        match self.recv()? {
+            DeviceMessage::Prediction { values, .. } => Ok(values.to_vec()),
+            other => Err(HilError::Protocol {
+                expected: "Prediction",
+                got: format!("{other:?}"),
+            }),
+        }
+    }
+
+    /// Runs a whole record through the device (after loading `spec`).
+    ///
+    /// # Errors
+    /// As [`Device::step`].
+    pub fn run(
+        &mut self,
+        spec: &ModelSpec,
+        rec: &F32Record,
+        h: usize,
+    ) -> Result<Vec<Vec<f32>>, HilError> {
+        self.load(spec)?;
+        (0..rec.u.len())
+            .map(|t| {
+                self.step(
+                    rec.u[t],
+                    rec.y[t],
+                    rec.psi(t),
+                    &future_inputs(&rec.u, t, h),
+                    h,
+                )
+            })
+            .collect()
+    }
+
+    /// Ends a QEMU run (`Shutdown`), or just closes a serial link.
+    pub fn close(mut self) {
+        if self.child.is_some() {
+            let _ = self.send(&HostMessage::Shutdown { code: 0 });
+            let _ = self.port.write_all(&self.tx);
+            let _ = self.port.flush();
+            let start = Instant::now();
+            while start.elapsed() < Duration::from_secs(5) {
+                if let Some(c) = self.child.as_mut() {
+                    if let Ok(Some(_)) = c.try_wait() {
+                        self.child = None;
+                        break;
+                    }
+                }
+                std::thread::sleep(Duration::from_millis(20));
+            }
+        }
+    }
+}
+
+impl Drop for Device {
+    fn drop(&mut self) {
+        if let Some(mut c) = self.child.take() {
+            if let Ok(None) = c.try_wait() {
+                let _ = c.kill();
+            }
+            let _ = c.wait();
+        }
+    }
+}
+
+/// Bit-for-bit comparison of two prediction runs: (values compared, values equal, first
+/// differing (sample, step)).
+pub fn compare_bits(a: &[Vec<f32>], b: &[Vec<f32>]) -> (usize, usize, Option<(usize, usize)>) {
+    let mut total = 0;
+    let mut equal = 0;
+    let mut first = None;
+    for (t, (x, y)) in a.iter().zip(b).enumerate() {
+        for (k, (p, q)) in x.iter().zip(y).enumerate() {
+            total += 1;
+            if p.to_bits() == q.to_bits() {
+                equal += 1;
+            } else if first.is_none() {
+                first = Some((t, k));
+            }
+        }
+        if x.len() != y.len() && first.is_none() {
+            first = Some((t, x.len().min(y.len())));
+        }
+    }
+    if a.len() != b.len() && first.is_none() {
+        first = Some((a.len().min(b.len()), 0));
+    }
+    (total, equal, first)
+}
+
+/// Running fit % of the k-step predictions made so far: for each k in `ks`, ŷ(t|t−k) from
+/// the predictions issued at t−k against the measured y(t).
+#[derive(Debug, Clone)]
+pub struct LiveFit {
+    ks: Vec<usize>,
+    y: Vec<f64>,
+    preds: Vec<Vec<f64>>,
+}
+
+impl LiveFit {
+    /// Tracks the horizons `ks` (each ≥ 1).
+    pub fn new(ks: &[usize]) -> LiveFit {
+        LiveFit {
+            ks: ks.to_vec(),
+            y: Vec::new(),
+            preds: Vec::new(),
+        }
+    }
+
+    /// Adds the measurement y(t) and the prediction vector issued at t (ŷ(t+1|t) …).
+    pub fn push(&mut self, y: f64, pred: &[f32]) {
+        self.y.push(y);
+        self.preds
+            .push(pred.iter().map(|v| f64::from(*v)).collect());
+    }
+
+    /// Fit % per tracked horizon over the samples so far (NaN until there are enough).
+    ///
+    /// ```
+    /// use yawcast::hil::LiveFit;
+    /// let mut f = LiveFit::new(&[1]);
+    /// for t in 0..10 {
+    ///     let y = t as f64;
+    ///     f.push(y, &[(t + 1) as f32]); // perfect one-step predictions
+    /// }
+    /// assert_eq!(f.fits(), vec![(1, 100.0)]);
+    /// ```
+    pub fn fits(&self) -> Vec<(usize, f64)> {
+        self.ks
+            .iter()
+            .map(|&k| {
+                let mut y = Vec::new();
+                let mut yh = Vec::new();
+                for t in k..self.y.len() {
+                    if let Some(v) = self.preds[t - k].get(k - 1) {
+                        y.push(self.y[t]);
+                        yh.push(*v);
+                    }
+                }
+                let f = if y.len() < 3 {
+                    f64::NAN
+                } else {
+                    crate::predict::fit(&y, &yh)
+                };
+                (k, f)
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use yawcast_shared::model::Units;
+
+    fn spec() -> ModelSpec {
+        ModelSpec::new(
+            4,
+            0.5,
+            &[-0.086_45, 0.6135, -1.785, 2.25],
+            &[0.02, 0.035, 0.045, 0.05],
+            &[0.55, 0.45, 0.35, 0.25],
+            Units::default(),
+            &[],
+        )
+        .unwrap()
+    }
+
+    fn rec() -> F32Record {
+        let u: Vec<f32> = (0..200)
+            .map(|i| if (i / 17) % 2 == 0 { 10.0 } else { -10.0 })
+            .collect();
+        let y: Vec<f32> = (0..200).map(|i| (i as f32 * 0.05).sin()).collect();
+        F32Record { u, y, psi: None }
+    }
+
+    #[test]
+    fn native_run_is_deterministic_and_sized() {
+        let a = native_run(&spec(), &rec(), 20).unwrap();
+        let b = native_run(&spec(), &rec(), 20).unwrap();
+        assert_eq!(a.len(), 200);
+        assert!(a.iter().all(|v| v.len() == 20));
+        assert_eq!(compare_bits(&a, &b), (4000, 4000, None));
+        let mut c = b.clone();
+        c[7][3] = f32::from_bits(c[7][3].to_bits() ^ 1);
+        assert_eq!(compare_bits(&a, &c), (4000, 3999, Some((7, 3))));
+    }
+
+    #[test]
+    fn future_inputs_repeat_the_last_command() {
+        assert_eq!(future_inputs(&[1.0, 2.0, 3.0], 1, 4), vec![3.0, 3.0, 3.0]);
+        assert_eq!(future_inputs(&[1.0, 2.0, 3.0], 0, 1), Vec::<f32>::new());
+    }
+
+    #[test]
+    fn missing_elf_names_where_it_looked() {
+        if std::env::var_os(ELF_VAR).is_some() {
+            return;
+        }
+        let e = find_elf(Path::new("/nonexistent-ws"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("/nonexistent-ws/target") && e.contains("fw-build"),
+            "{e}"
+        );
+    }
+}
