@@ -766,7 +766,10 @@ def _manual_kstep(m: SSModel, rec: Record, x0, k, t):
     return float(st.x[0] @ m.C + m.d_y + m.y0)
 
 
-def cmd_selftest(_args):
+def cmd_selftest(_args=None):
+    import warnings
+
+    warnings.filterwarnings("ignore")
     failures = []
 
     def check(cond, what):
@@ -832,6 +835,40 @@ def cmd_selftest(_args):
     check(d < 1e-6, f"NARX free run == sysidentpy's free run (max {d:.1e})")
     # fit definition
     check(fit_percent([1, 2, 3], [1, 2, 3]) == 100.0 and fit_percent([1, 2, 3], [2, 2, 2]) == 0.0, "fit % definition")
+    # the shared predictor == `yawcast compare` on canonical models with every effect
+    binary = yawcast_binary(getattr(_args, "yawcast", None), allow_debug=True)
+    if binary is None:
+        print("skip yawcast compare cross-check (no yawcast binary)")
+    else:
+        import tempfile
+
+        with tempfile.TemporaryDirectory() as td:
+            td = Path(td)
+            xr = standin_record("xc", 5, n=600)
+            write_record(td / "xc.csv", xr)
+            sets = [
+                [],
+                [{"effect": "dead-time", "samples": 2}],
+                [{"effect": "rate-limit", "rate": 4.0}, {"effect": "saturation", "limit": 12.0}],
+                [{"effect": "bias", "beta": 0.3}, {"effect": "gyro-bias", "d_y": 0.05}],
+                [{"effect": "asymmetry", "beta": 0.2}, {"effect": "nonlinear-damping", "beta": -0.5, "cubic": False}],
+                [{"effect": "nonlinear-damping", "beta": -0.2, "cubic": True}],
+                [{"effect": "wind", "beta_s2": 0.1, "beta_c2": -0.2, "beta_s1": 0.05, "beta_c1": 0.0},
+                 {"effect": "current", "beta_s": 0.1, "beta_c": 0.1}],
+            ]
+            for effs in sets:
+                doc = {"n": 4, "ts": xr.ts, "a": STANDIN_A, "b": STANDIN_B, "k": [0.3, 0.2, 0.1, 0.05], "effects": effs}
+                (td / "m.json").write_text(json.dumps(doc))
+                p = subprocess.run([str(binary), "compare", "--model", str(td / "m.json"), "--data",
+                                    str(td / "xc.csv"), "--json", str(td / "c.json")], capture_output=True, text=True)
+                what = "+".join(e["effect"] for e in effs) or "linear"
+                if p.returncode != 0:
+                    check(False, f"yawcast compare ran ({what}): {p.stderr.strip()[:200]}")
+                    continue
+                theirs = _compare_fits(json.loads((td / "c.json").read_text()))
+                mine = score(load_model(td / "m.json"), read_record(td / "xc.csv"))
+                d = max(abs(theirs[h] - mine[h]) for h in HORIZONS)
+                check(d < 1e-9, f"shared predictor == yawcast compare, {what} (max {d:.1e} pp)")
     print(f"{len(failures) == 0 and 'selftest passed' or 'selftest FAILED'}")
     return 0 if not failures else 1
 
@@ -1258,6 +1295,14 @@ def cmd_bench(args):
         tmp.write_text(report)
         os.replace(tmp, out)
         say(f"wrote {out}")
+    errors = [r for r in rows if "error" in r]
+    for r in errors:
+        say(f"error: {r['tool']} on {r['case']}: {r['error']}")
+    if args.smoke:
+        # the smoke run checks that the pipeline works end to end, not the targets
+        bad = errors or [r for r in rows if not all(math.isfinite(v) for v in r["fits"].values())]
+        say(f"smoke: {'FAILED' if bad else 'ok'} ({len(rows)} models scored, {len(bad)} failed)")
+        return 1 if bad else 0
     return 0
 
 
@@ -1507,7 +1552,8 @@ def main(argv=None):
     f.add_argument("--peer", required=True, choices=list(PEERS))
     f.add_argument("--data", required=True)
     f.add_argument("--out", required=True)
-    sub.add_parser("selftest", help="checks of the shared predictor")
+    st = sub.add_parser("selftest", help="checks of the shared predictor")
+    st.add_argument("--yawcast", default=None, help="path of the yawcast binary (cross-check with compare)")
     args = ap.parse_args(argv)
     if args.cmd == "fit":
         return cmd_fit(args)
