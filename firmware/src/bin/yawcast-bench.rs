@@ -1,0 +1,165 @@
+//! yawcast-bench: instruction-count benchmark kernels for `bench/firmware/run.sh`.
+//!
+//! The same kernels run on the Cortex-M4F (in QEMU, counted from a single-step execution
+//! trace) and on x86_64 (counted by callgrind). Each kernel calls the predictor through a
+//! non-inlined function, as an application would, with inputs hidden from the optimiser.
+//! Counting N and 2N calls and taking the difference removes start-up and measurement
+//! overhead; an identical loop around an empty call gives the harness cost to subtract.
+//!
+//! On the M4 the phases are separated by calls to `bench_marker`; on the host the phase is
+//! chosen on the command line: `yawcast-bench update|predict|empty N`.
+#![cfg_attr(target_os = "none", no_std)]
+#![cfg_attr(target_os = "none", no_main)]
+
+use core::hint::black_box;
+use yawcast_firmware::{Predictor, PredictorError, UpdateStatus};
+use yawcast_shared::model::{ModelSpec, Units};
+
+/// Prediction horizon benchmarked.
+const H: usize = 20;
+
+/// The base 4th-order model of the golden tests (`tests/src/lib.rs`).
+fn base_model() -> Option<ModelSpec> {
+    ModelSpec::new(
+        4,
+        0.5,
+        &[-0.086_45, 0.6135, -1.785, 2.25],
+        &[0.02, 0.035, 0.045, 0.05],
+        &[0.55, 0.45, 0.35, 0.25],
+        Units::default(),
+        &[],
+    )
+    .ok()
+}
+
+#[inline(never)]
+fn one_update(p: &mut Predictor<4>, u: f32, y: f32) -> UpdateStatus {
+    p.update(u, y)
+}
+
+#[inline(never)]
+fn one_predict(
+    p: &Predictor<4>,
+    out: &mut [f32; H],
+    fu: &[f32; H - 1],
+) -> Result<(), PredictorError> {
+    p.predict_into(out, fu)
+}
+
+#[inline(never)]
+fn empty_call(p: &mut Predictor<4>, u: f32, y: f32) -> UpdateStatus {
+    black_box((p, u, y));
+    UpdateStatus::Corrected
+}
+
+/// `n` updates with alternating measurements.
+#[inline(never)]
+fn run_updates(p: &mut Predictor<4>, n: u32) {
+    for i in 0..n {
+        let y = if i & 1 == 0 { 0.5 } else { -0.25 };
+        black_box(one_update(p, black_box(2.0), black_box(y)));
+    }
+}
+
+/// The harness of `run_updates` around an empty call.
+#[inline(never)]
+fn run_empty(p: &mut Predictor<4>, n: u32) {
+    for i in 0..n {
+        let y = if i & 1 == 0 { 0.5 } else { -0.25 };
+        black_box(empty_call(p, black_box(2.0), black_box(y)));
+    }
+}
+
+/// `n` 20-step predictions.
+#[inline(never)]
+fn run_predicts(p: &Predictor<4>, out: &mut [f32; H], fu: &[f32; H - 1], n: u32) {
+    for _ in 0..n {
+        let r = one_predict(black_box(p), out, black_box(fu));
+        let _ = black_box(r);
+        black_box(&out);
+    }
+}
+
+/// Builds a predictor warmed up with a few samples.
+fn predictor() -> Option<Predictor<4>> {
+    let mut p = Predictor::<4>::new(&base_model()?).ok()?;
+    for i in 0..50 {
+        let u = if (i / 7) % 2 == 0 { 5.0 } else { -5.0 };
+        p.update(u, 0.1 * i as f32);
+    }
+    Some(p)
+}
+
+fn future_u() -> [f32; H - 1] {
+    core::array::from_fn(|i| if i % 5 < 2 { 4.0 } else { -3.0 })
+}
+
+#[cfg(target_os = "none")]
+mod m4 {
+    use super::*;
+    use cortex_m as _;
+    use cortex_m_rt::entry;
+    use defmt_semihosting as _;
+
+    /// Calls per phase; the script counts N and 2N.
+    const N: u32 = 200;
+
+    /// Phase boundary, found in the trace by its address.
+    #[inline(never)]
+    fn bench_marker(id: u32) {
+        black_box(id);
+    }
+
+    #[entry]
+    fn main() -> ! {
+        let Some(mut p) = predictor() else {
+            semihosting::process::exit(2)
+        };
+        let fu = future_u();
+        let mut out = [0.0f32; H];
+        bench_marker(0);
+        run_updates(&mut p, N);
+        bench_marker(1);
+        run_updates(&mut p, 2 * N);
+        bench_marker(2);
+        run_predicts(&p, &mut out, &fu, N);
+        bench_marker(3);
+        run_predicts(&p, &mut out, &fu, 2 * N);
+        bench_marker(4);
+        run_empty(&mut p, N);
+        bench_marker(5);
+        run_empty(&mut p, 2 * N);
+        bench_marker(6);
+        defmt::info!("bench done, last prediction {=f32}", out[H - 1]);
+        semihosting::process::exit(0)
+    }
+
+    #[panic_handler]
+    fn panic(_: &core::panic::PanicInfo) -> ! {
+        semihosting::process::exit(101)
+    }
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let usage = "usage: yawcast-bench update|predict|empty N";
+    let (Some(mode), Some(n)) = (args.get(1), args.get(2).and_then(|n| n.parse::<u32>().ok()))
+    else {
+        eprintln!("{usage}");
+        std::process::exit(2);
+    };
+    let mut p = predictor().expect("benchmark model");
+    let fu = future_u();
+    let mut out = [0.0f32; H];
+    match mode.as_str() {
+        "update" => run_updates(&mut p, n),
+        "predict" => run_predicts(&p, &mut out, &fu, n),
+        "empty" => run_empty(&mut p, n),
+        _ => {
+            eprintln!("{usage}");
+            std::process::exit(2);
+        }
+    }
+    println!("{mode} x{n}: last prediction {:e}", out[H - 1]);
+}
