@@ -3,6 +3,7 @@
 #![deny(missing_docs)]
 
 pub mod data;
+pub mod demo;
 pub mod hil;
 pub mod model;
 pub mod nmea;

@@ -149,7 +149,25 @@ impl Block {
             .collect();
         Block::Chart {
             caption: String::new(),
-            svg: svg::bar_chart(title, ylabel, &groups, &series, Some(-100.0)),
+            svg: svg::bar_chart(title, ylabel, &groups, &series, Some(-100.0), None),
+        }
+    }
+    /// A grouped bar chart block with bars above `cap` cut there (and labelled).
+    pub fn bars_capped(
+        title: &str,
+        ylabel: &str,
+        groups: &[&str],
+        series: &[(&str, Vec<f64>)],
+        cap: f64,
+    ) -> Block {
+        let groups: Vec<String> = groups.iter().map(|s| s.to_string()).collect();
+        let series: Vec<(String, Vec<f64>)> = series
+            .iter()
+            .map(|(n, v)| (n.to_string(), v.clone()))
+            .collect();
+        Block::Chart {
+            caption: String::new(),
+            svg: svg::bar_chart(title, ylabel, &groups, &series, Some(-100.0), Some(cap)),
         }
     }
     /// A correlation stem chart with its band.
@@ -234,8 +252,8 @@ body{margin:0;background:var(--bg);color:var(--ink);font:15px/1.5 system-ui,-app
 header{background:#14324f;color:#fff;padding:22px 40px 18px}
 header h1{margin:0;font-size:26px;font-weight:650;letter-spacing:.2px}
 header p{margin:4px 0 0;color:#c9d6e3}
-nav{background:#fff;border-bottom:1px solid var(--line);padding:8px 40px;position:sticky;top:0}
-nav a{color:var(--accent);text-decoration:none;margin-right:16px;font-size:14px;white-space:nowrap}
+nav{background:#fff;border-bottom:1px solid var(--line);padding:8px 40px;display:flex;flex-wrap:wrap;gap:4px 16px}
+nav a{color:var(--accent);text-decoration:none;font-size:14px;white-space:nowrap}
 main{max-width:1000px;margin:0 auto;padding:22px 24px 60px}
 section{background:#fff;border:1px solid var(--line);border-radius:8px;padding:18px 24px 20px;margin:0 0 22px}
 h2{margin:0 0 6px;font-size:20px}

@@ -317,6 +317,21 @@ pub fn line_chart(
     out
 }
 
+/// A bar's value label: three significant digits, at most one decimal above 10.
+fn bar_label(v: f64) -> String {
+    let a = v.abs();
+    if a >= 100.0 {
+        format!("{v:.0}")
+    } else if a >= 10.0 || a == 0.0 {
+        format!("{v:.1}")
+    } else if a >= 1.0 {
+        format!("{v:.2}")
+    } else {
+        let dec = (2.0 - a.log10().floor()) as usize;
+        format!("{v:.dec$}")
+    }
+}
+
 fn clip_id(title: &str) -> String {
     let h = title.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
         (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3)
@@ -393,13 +408,15 @@ pub fn stem_chart(title: &str, xlabel: &str, lags: &[f64], values: &[f64], band:
 }
 
 /// Grouped horizontal-axis bars: `groups` along x, one bar per series in each group.
-/// Values below `floor` are drawn down to the floor and labelled with their value.
+/// Values below `floor` (above `cap`) are drawn to the floor (cap) and labelled with their
+/// true value.
 pub fn bar_chart(
     title: &str,
     ylabel: &str,
     groups: &[String],
     series: &[(String, Vec<f64>)],
     floor: Option<f64>,
+    cap: Option<f64>,
 ) -> String {
     let mut lo = 0.0f64;
     let mut hi = f64::NEG_INFINITY;
@@ -416,6 +433,9 @@ pub fn bar_chart(
     }
     if !hi.is_finite() {
         hi = 1.0;
+    }
+    if let Some(c) = cap {
+        hi = hi.min(c);
     }
     let f = Frame::new(-0.5, groups.len() as f64 - 0.5, lo, hi.max(lo + 1e-9), H);
     let mut out = String::new();
@@ -445,7 +465,7 @@ pub fn bar_chart(
                 );
                 continue;
             }
-            let shown = v.max(f.y0);
+            let shown = v.max(f.y0).min(f.y1);
             let (ya, yb) = (f.py(shown.max(0.0)), f.py(shown.min(0.0).max(f.y0)));
             let _ = write!(
                 out,
@@ -457,11 +477,7 @@ pub fn bar_chart(
                 esc(&series[s].0),
                 x + bw / 2.0,
                 ya.min(yb) - 3.0,
-                if v.abs() >= 100.0 {
-                    format!("{v:.0}")
-                } else {
-                    format!("{v:.1}")
-                }
+                bar_label(v)
             );
         }
     }
@@ -522,8 +538,18 @@ mod tests {
                 ("b".into(), vec![f64::NAN, 50.0]),
             ],
             Some(-50.0),
+            None,
         );
         assert!(s.contains("n/a") && s.contains("-500"));
+    }
+
+    #[test]
+    fn bar_labels_keep_three_significant_digits() {
+        assert_eq!(bar_label(0.0123), "0.0123");
+        assert_eq!(bar_label(0.2), "0.200");
+        assert_eq!(bar_label(4.2), "4.20");
+        assert_eq!(bar_label(88.04), "88.0");
+        assert_eq!(bar_label(-512.3), "-512");
     }
 
     #[test]
