@@ -254,6 +254,9 @@ pub struct Device {
     pub order: u8,
     /// Where QEMU's own output (defmt log) goes, when running under QEMU.
     pub log: Option<PathBuf>,
+    /// Samples sent ahead before reading answers (QEMU applies flow control on its socket,
+    /// so it can take many; a board's UART is read one sample at a time).
+    pub window: usize,
 }
 
 impl Device {
@@ -315,6 +318,7 @@ impl Device {
         let mut d = Device::over(Box::new(stream));
         d.child = child;
         d.log = Some(log);
+        d.window = 32;
         d.expect_banner()?;
         Ok(d)
     }
@@ -359,6 +363,7 @@ impl Device {
             tx: Vec::new(),
             order: 0,
             log: None,
+            window: 1,
         }
     }
 
@@ -462,12 +467,27 @@ impl Device {
         future_u: &[f32],
         h: usize,
     ) -> Result<Vec<f32>, HilError> {
+        self.queue_step(u, y, psi, future_u, h)?;
+        self.answer()
+    }
+
+    fn queue_step(
+        &mut self,
+        u: f32,
+        y: f32,
+        psi: Option<f32>,
+        future_u: &[f32],
+        h: usize,
+    ) -> Result<(), HilError> {
         let fu: FutureInputs = future_u.iter().copied().take(h.saturating_sub(1)).collect();
         self.send(&HostMessage::Measurement { u, y, psi })?;
         self.send(&HostMessage::PredictRequest {
             horizon: h as u8,
             future_u: fu,
-        })?;
+        })
+    }
+
+    fn answer(&mut self) -> Result<Vec<f32>, HilError> {
         match self.recv()? {
             DeviceMessage::Ack { .. } => {}
             other => {
@@ -497,17 +517,40 @@ impl Device {
         h: usize,
     ) -> Result<Vec<Vec<f32>>, HilError> {
         self.load(spec)?;
-        (0..rec.u.len())
-            .map(|t| {
-                self.step(
-                    rec.u[t],
-                    rec.y[t],
-                    rec.psi(t),
-                    &future_inputs(&rec.u, t, h),
+        self.steps(rec, 0..rec.u.len(), h)
+    }
+
+    /// Runs samples `range` of a record through the device (model already loaded),
+    /// [`Device::window`] samples in flight at a time.
+    ///
+    /// # Errors
+    /// As [`Device::step`].
+    pub fn steps(
+        &mut self,
+        rec: &F32Record,
+        range: std::ops::Range<usize>,
+        h: usize,
+    ) -> Result<Vec<Vec<f32>>, HilError> {
+        let mut out = Vec::with_capacity(range.len());
+        let w = self.window.max(1);
+        let mut t = range.start;
+        while t < range.end {
+            let end = (t + w).min(range.end);
+            for s in t..end {
+                self.queue_step(
+                    rec.u[s],
+                    rec.y[s],
+                    rec.psi(s),
+                    &future_inputs(&rec.u, s, h),
                     h,
-                )
-            })
-            .collect()
+                )?;
+            }
+            for _ in t..end {
+                out.push(self.answer()?);
+            }
+            t = end;
+        }
+        Ok(out)
     }
 
     /// Ends a QEMU run (`Shutdown`), or just closes a serial link.

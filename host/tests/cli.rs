@@ -319,3 +319,77 @@ fn failed_run_leaves_no_partial_output() {
         .collect();
     assert!(leftovers.is_empty());
 }
+
+/// The firmware ELF for QEMU, when this machine has QEMU and a built firmware.
+fn qemu_elf() -> Option<PathBuf> {
+    let qemu = Command::new("qemu-system-arm")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !qemu {
+        return None;
+    }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()?
+        .to_path_buf();
+    let mut c: Vec<PathBuf> = std::env::var_os("YAWCAST_FW_ELF")
+        .map(PathBuf::from)
+        .into_iter()
+        .collect();
+    for sub in ["target", "target/thumb"] {
+        c.push(
+            root.join(sub)
+                .join("thumbv7em-none-eabihf/release/yawcast-fw"),
+        );
+    }
+    c.into_iter().find(|p| p.is_file())
+}
+
+#[test]
+fn hil_in_qemu_is_bit_exact() {
+    let Some(elf) = qemu_elf() else {
+        eprintln!("hil_in_qemu_is_bit_exact: skipped (no qemu-system-arm or no firmware ELF)");
+        return;
+    };
+    let d = scratch("hil");
+    let m = d.join("m4.json");
+    std::fs::write(
+        &m,
+        r#"{"n":4,"ts":0.5,"a":[-0.08645,0.6135,-1.785,2.25],"b":[0.02,0.035,0.045,0.05],
+            "k":[0.55,0.45,0.35,0.25],"effects":[{"effect":"rate-limit","rate":4.0}]}"#,
+    )
+    .unwrap();
+    let rec = d.join("voyage.csv");
+    std::fs::write(&rec, csv_text(300, 0.5)).unwrap();
+    let json = d.join("hil.json");
+    let o = run(&[
+        "hil",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        rec.to_str().unwrap(),
+        "--elf",
+        elf.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}\n{}", stdout(&o), stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(v["bit_exact"], true);
+    assert_eq!(v["values"], 300 * 20);
+    assert_eq!(v["target"], "qemu");
+    assert!(v["fit"]["20"].is_f64());
+    // A model of another order than the firmware runs is refused with a clear message.
+    let m2 = write_model(&d);
+    let o = run(&[
+        "hil",
+        "--model",
+        m2.to_str().unwrap(),
+        "--data",
+        d.join("voyage.csv").to_str().unwrap(),
+        "--elf",
+        elf.to_str().unwrap(),
+    ]);
+    assert_ne!(code(&o), 0);
+    assert!(stderr(&o).contains("order"), "{}", stderr(&o));
+}

@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 
 pub mod common;
 pub mod compare;
+pub mod hil;
 
 /// yawcast — ship trials to a yaw-rate predictor that runs on the ship's controller.
 ///
@@ -41,7 +42,7 @@ pub enum Command {
     /// The whole story on the built-in ship with a hidden effect, ending in report.html.
     Demo(Pending),
     /// Hardware in the loop: the simulator sails, the firmware (QEMU or a board) predicts.
-    Hil(Pending),
+    Hil(hil::HilArgs),
 }
 
 /// Arguments of a tool not wired into this build yet.
@@ -73,6 +74,38 @@ impl Command {
 pub fn run(cli: Cli) -> Result<()> {
     match &cli.command {
         Command::Compare(a) => compare::run(a),
+        Command::Hil(a) => hil::run(a),
         other => anyhow::bail!("`yawcast {}` is not available in this build", other.name()),
     }
+}
+
+/// A seeded voyage of `steps` samples for the live loop: pseudo-random pod commands
+/// (random switching intervals, several amplitudes) and the yaw rate the model itself
+/// produces, with gyro noise.
+pub fn sail(
+    model: &yawcast::model::Model,
+    steps: usize,
+    seed: u64,
+) -> Result<yawcast::data::Record> {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut u = Vec::with_capacity(steps);
+    let mut cur = 0.0;
+    let mut left = 0usize;
+    for _ in 0..steps {
+        if left == 0 {
+            let amp = [5.0, 10.0, 20.0, 30.0][rng.random_range(0..4)];
+            cur = if rng.random_bool(0.5) { amp } else { -amp };
+            left = rng.random_range(4..30);
+        }
+        left -= 1;
+        u.push(cur);
+    }
+    let rec = yawcast::data::Record::from_uy("voyage", model.ts, u, vec![0.0; steps]);
+    let clean = yawcast::predict::simulate(model, &rec, &vec![0.0; model.n]);
+    let y = clean
+        .iter()
+        .map(|v| v + 0.01 * (rng.random::<f64>() - 0.5))
+        .collect();
+    Ok(yawcast::data::Record { y, ..rec })
 }
