@@ -917,6 +917,97 @@ impl Outcome {
     }
 }
 
+/// Checks an exported blob through the firmware: the firmware library on this machine runs
+/// the model as exported (`blob` read back) and as the host converted it, over `rec`, and
+/// both must agree bit for bit; when `elf` is given and QEMU is installed, the firmware on
+/// an emulated Cortex-M4F runs the first `qemu_samples` samples and must agree too. Also
+/// compares the host's f64 and the firmware's f32 10-step fit (zero initial state, samples
+/// from the 10th on).
+///
+/// # Errors
+/// [`crate::hil::HilError`] when the blob does not decode or the firmware refuses the
+/// model; a QEMU failure is reported in [`FirmwareCheck::qemu_note`], not as an error.
+pub fn firmware_check(
+    model: &Model,
+    blob: &[u8],
+    rec: &Record,
+    elf: Option<&std::path::Path>,
+    qemu_samples: usize,
+) -> Result<FirmwareCheck, crate::hil::HilError> {
+    use crate::hil::{self, compare_bits, native_run, F32Record};
+    const H: usize = 20;
+    const K: usize = 10;
+    let spec_host = model
+        .to_spec()
+        .map_err(|e| hil::HilError::Model(e.to_string()))?;
+    let spec_blob = yawcast_shared::blob::decode_blob(blob)
+        .map_err(|e| hil::HilError::Model(format!("the exported blob: {e}")))?;
+    let f32rec = F32Record::new(rec);
+    let golden = native_run(&spec_host, &f32rec, H)?;
+    let native = native_run(&spec_blob, &f32rec, H)?;
+    let (values, native_equal, _) = compare_bits(&golden, &native);
+    let (qemu_equal, qemu_note) = match elf {
+        None => (
+            None,
+            "not run: no firmware ELF built (cargo fw-build)".to_string(),
+        ),
+        Some(_) if !hil::qemu_available() => (
+            None,
+            "not run: qemu-system-arm is not installed".to_string(),
+        ),
+        Some(elf) => {
+            let n = qemu_samples.min(f32rec.u.len());
+            let part = F32Record {
+                u: f32rec.u[..n].to_vec(),
+                y: f32rec.y[..n].to_vec(),
+                psi: f32rec.psi.as_ref().map(|p| p[..n].to_vec()),
+            };
+            let run = hil::Device::qemu(elf).and_then(|mut d| {
+                let r = d.run(&spec_blob, &part, H);
+                d.close();
+                r
+            });
+            match run {
+                Ok(q) => {
+                    // Compare on the first n samples, scaled to the whole-record count.
+                    let (total, eq, _) = compare_bits(&q, &native[..n]);
+                    let scaled = if eq == total { values } else { eq };
+                    (
+                        Some(scaled),
+                        format!("{eq} of {total} values ({n} samples × {H} steps) equal on the emulated Cortex-M4F"),
+                    )
+                }
+                Err(e) => (Some(0), format!("failed: {e}")),
+            }
+        }
+    };
+    // f64 vs f32 at K steps, same (zero) initial state, from sample K on.
+    let host = crate::predict::k_step(model, rec, &vec![0.0; model.n], K);
+    let mut fw = vec![f64::NAN; rec.len()];
+    for t in K..rec.len() {
+        fw[t] = f64::from(native[t - K][K - 1]);
+    }
+    let fit_f64 = crate::predict::fit(&rec.y[K..], &host[K..]);
+    let fit_f32 = crate::predict::fit(&rec.y[K..], &fw[K..]);
+    let mut host_plot = host;
+    for v in host_plot.iter_mut().take(K) {
+        *v = f64::NAN;
+    }
+    Ok(FirmwareCheck {
+        values,
+        native_equal,
+        qemu_equal,
+        qemu_note,
+        fit_f64,
+        fit_f32,
+        blob_bytes: blob.len(),
+        t: rec.t.clone(),
+        y: rec.y.clone(),
+        host: host_plot,
+        firmware: fw,
+    })
+}
+
 /// The effect in words ("a command dead time", …).
 pub fn effect_phrase(name: &str) -> &'static str {
     match name {
@@ -1114,6 +1205,29 @@ pub(crate) mod tests {
             }
         }
         assert_eq!(v["firmware_bit_exact"], true);
+    }
+
+    #[test]
+    fn firmware_check_natively() {
+        let o = sample();
+        let m = &o.tuned.model;
+        let spec = m.to_spec().unwrap();
+        let mut buf = [0u8; yawcast_shared::blob::MAX_BLOB_LEN];
+        let blob = yawcast_shared::blob::encode_blob(&spec, &mut buf).unwrap();
+        let fc = firmware_check(m, blob, &o.trials[0], None, 0).unwrap();
+        assert_eq!(fc.values, 600 * 20);
+        assert_eq!(fc.native_equal, fc.values);
+        assert!(fc.bit_exact());
+        assert!(
+            (fc.fit_f64 - fc.fit_f32).abs() < 0.01,
+            "{} {}",
+            fc.fit_f64,
+            fc.fit_f32
+        );
+        assert!(fc.qemu_note.contains("not run"));
+        let mut bad = blob.to_vec();
+        bad[10] ^= 1;
+        assert!(firmware_check(m, &bad, &o.trials[0], None, 0).is_err());
     }
 
     /// Writes the sample page for a look in a browser: `YAWCAST_REPORT_PREVIEW=path`.
