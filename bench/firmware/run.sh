@@ -4,8 +4,10 @@
 # x86_64 (callgrind), and the section sizes of the release firmware.
 #
 # Method: `yawcast-bench` runs each kernel N and 2N times; the difference of the two counts
-# divided by N is the cost of one loop iteration (call, predictor, loop). The same loop
-# around an empty call gives the harness cost, subtracted for the "net" column.
+# divided by N is the cost of one call. Two counts are reported: the instructions executed
+# inside `yawcast_firmware` functions (the predictor itself; on the M4 by PC range from the
+# symbol table, on x86_64 from callgrind's per-function costs), and the whole loop iteration
+# (harness, wrapper call and predictor). The same loop around an empty call shows the harness.
 #
 # Usage: bash bench/firmware/run.sh         (needs qemu-system-arm, valgrind, binutils)
 # Output: a Markdown table on stdout and in target/bench-firmware/results.md.
@@ -32,60 +34,89 @@ FW="target/$THUMB/release/yawcast-fw"
 BENCH_X86="target/release/yawcast-bench"
 
 # --- Cortex-M4F: one trace, phases separated by calls to bench_marker -------------------
+# Counted per phase: every instruction, and those whose PC lies in a yawcast_firmware
+# function (the library's own instructions, wrapper and loop excluded).
 echo "tracing on the Cortex-M4F (QEMU, one instruction per block)..." >&2
 rm -f "$OUT/m4.trace.log"
 timeout 300 qemu-system-arm -machine netduinoplus2 -nographic -monitor none \
     -semihosting-config enable=on,target=native \
     -singlestep -d exec,nochain -D "$OUT/m4.trace.log" \
     -kernel "$BENCH_M4" >"$OUT/m4.stdout" 2>&1
-marker_sym=$(nm "$BENCH_M4" | awk '/bench_marker/ { print $1; exit }')
+hex8() { printf '%08x' $(( $1 )); }
+marker_sym=$(nm "$BENCH_M4" | awk '/bench_marker/ && !f { print $1; f = 1 }')
 [ -n "$marker_sym" ] || { echo "bench_marker not found in $BENCH_M4" >&2; exit 1; }
-marker=$(printf '%08x' $((0x$marker_sym & ~1)))
-read -r -a marks < <(awk -v m="$marker" '
-    /^Trace/ {
-        n++
-        if (match($0, /\[[0-9a-f]+\/[0-9a-f]+\//)) {
-            split(substr($0, RSTART + 1, RLENGTH - 2), f, "/")
-            if (f[2] == m) printf "%d ", n
-        }
+marker=$(hex8 "0x$marker_sym & ~1")
+ranges=""
+while read -r addr size; do
+    lo=$((0x$addr & ~1))
+    ranges+="$(hex8 "$lo") $(hex8 "$lo + 0x$size") "
+done < <(nm -C -S --defined-only "$BENCH_M4" | awk '/ yawcast_firmware::/ && NF >= 4 { print $1, $2 }')
+[ -n "$ranges" ] || { echo "no yawcast_firmware functions in $BENCH_M4" >&2; exit 1; }
+# hex strings of equal width compare like numbers when compared as strings ("x" prefix)
+read -r -a counts < <(awk -v m="$marker" -v ranges="$ranges" '
+    BEGIN {
+        n = split(ranges, r, " ")
+        for (i = 1; i < n; i += 2) { k++; lo[k] = "x" r[i]; hi[k] = "x" r[i + 1] }
+        phase = -1
     }
-    END { print "" }' "$OUT/m4.trace.log")
-if [ "${#marks[@]}" -ne 7 ]; then
-    echo "expected 7 marker hits in the trace, found ${#marks[@]}" >&2
+    /^Trace/ {
+        if (!match($0, /\[[0-9a-f]+\/[0-9a-f]+\//)) next
+        split(substr($0, RSTART + 1, RLENGTH - 2), f, "/")
+        if (f[2] == m) phase++
+        if (phase < 0) next
+        tot[phase]++
+        p = "x" f[2]
+        for (j = 1; j <= k; j++) if (p >= lo[j] && p < hi[j]) { lib[phase]++; break }
+    }
+    END { printf "%d ", phase; for (i = 0; i < 6; i++) printf "%d %d ", tot[i], lib[i]; print "" }
+' "$OUT/m4.trace.log")
+if [ "${counts[0]}" -ne 6 ]; then
+    echo "expected 7 marker hits in the trace, found $((counts[0] + 1))" >&2
     exit 1
 fi
-per() { echo $(( ((${marks[$2]} - ${marks[$1]}) - (${marks[$1]} - ${marks[$(($1 - 1))]})) / N )); }
-m4_update=$(per 1 2)
-m4_predict=$(per 3 4)
-m4_empty=$(per 5 6)
+# counts: phases; then (total, library) for N update, 2N update, N predict, 2N predict, N empty, 2N empty
+diff_n() { echo $(( (${counts[$2]} - ${counts[$1]}) / N )); }
+m4_update_loop=$(diff_n 1 3);  m4_update_lib=$(diff_n 2 4)
+m4_predict_loop=$(diff_n 5 7); m4_predict_lib=$(diff_n 6 8)
+m4_empty_loop=$(diff_n 9 11)
 rm -f "$OUT/m4.trace.log"
 
-# --- x86_64: callgrind, collecting only inside the kernel loop ----------------------------
-x86_count() { # mode n -> instructions collected inside run_<mode>
-    local mode=$1 n=$2 fn
-    case $mode in update) fn=run_updates ;; predict) fn=run_predicts ;; empty) fn=run_empty ;; esac
-    valgrind --tool=callgrind --callgrind-out-file="$OUT/cg.$mode.$n" \
-        --toggle-collect="*$fn*" "$BENCH_X86" "$mode" "$n" >/dev/null 2>&1
-    awk '/^(summary|totals):/ { print $2; exit }' "$OUT/cg.$mode.$n"
+# --- x86_64: callgrind; instructions in yawcast_firmware functions, and the whole loop ---
+x86_counts() { # mode n -> "loop library" instruction counts
+    local mode=$1 n=$2 file
+    file="$OUT/cg.$mode.$n"
+    valgrind --tool=callgrind --callgrind-out-file="$file" \
+        "$BENCH_X86" "$mode" "$n" >/dev/null 2>&1
+    # the whole program (N more iterations between the two runs), and the library's
+    # exclusive costs summed
+    callgrind_annotate --auto=no --threshold=100 "$file" 2>/dev/null |
+        awk '/PROGRAM TOTALS/ { gsub(",", "", $1); t = $1 }
+             $0 ~ /:yawcast_firmware::/ { gsub(",", "", $1); s += $1 }
+             END { print t + 0, s + 0 }'
 }
-x86_per() { echo $(( ($(x86_count "$1" $((2 * N))) - $(x86_count "$1" "$N")) / N )); }
+x86_per() { # mode -> "loop library" per call
+    local a b
+    read -r -a a < <(x86_counts "$1" "$N")
+    read -r -a b < <(x86_counts "$1" $((2 * N)))
+    echo "$(( (b[0] - a[0]) / N )) $(( (b[1] - a[1]) / N ))"
+}
 echo "counting on x86_64 (callgrind)..." >&2
-x86_update=$(x86_per update)
-x86_predict=$(x86_per predict)
-x86_empty=$(x86_per empty)
+read -r x86_update_loop x86_update_lib < <(x86_per update)
+read -r x86_predict_loop x86_predict_lib < <(x86_per predict)
+read -r x86_empty_loop _ < <(x86_per empty)
 
 # --- sizes ---------------------------------------------------------------------------------
 sec() { size -A "$FW" | awk -v s="$1" '$1 == s { print $2 + 0; f = 1 } END { if (!f) print 0 }'; }
 text=$(sec .text); rodata=$(sec .rodata); data=$(sec .data); bss=$(sec .bss)
 
 {
-    echo "| measure | Cortex-M4F (QEMU) | x86_64 (callgrind) | target |"
+    echo "| instructions per call | Cortex-M4F (QEMU trace) | x86_64 (callgrind) | target (M4) |"
     echo "|---|---|---|---|"
-    echo "| \`update\`, per call incl. call + loop | $m4_update | $x86_update | |"
-    echo "| \`update\`, net of the empty-call harness | $((m4_update - m4_empty)) | $((x86_update - x86_empty)) | ≤ 60 (M4) |"
-    echo "| 20-step \`predict_into\`, per call incl. call + loop | $m4_predict | $x86_predict | |"
-    echo "| 20-step \`predict_into\`, net of the harness | $((m4_predict - m4_empty)) | $((x86_predict - x86_empty)) | ≤ 400 (M4) |"
-    echo "| empty-call harness | $m4_empty | $x86_empty | |"
+    echo "| \`update\`: in the library | $m4_update_lib | $x86_update_lib | ≤ 60 |"
+    echo "| \`update\`: whole loop iteration (harness + call + library) | $m4_update_loop | $x86_update_loop | |"
+    echo "| 20-step \`predict_into\`: in the library | $m4_predict_lib | $x86_predict_lib | ≤ 400 |"
+    echo "| 20-step \`predict_into\`: whole loop iteration | $m4_predict_loop | $x86_predict_loop | |"
+    echo "| the same loop around an empty call | $m4_empty_loop | $x86_empty_loop | |"
     echo
     echo "| section of \`yawcast-fw\` (release, defmt) | bytes | target |"
     echo "|---|---|---|"

@@ -297,9 +297,9 @@ impl<const N: usize> Predictor<N> {
     /// assert_eq!(p.update(f32::INFINITY, 0.0), UpdateStatus::NonFiniteReset);
     /// assert_eq!(p.state().x, [0.0, 0.0]);
     /// ```
-    #[inline]
+    #[inline(never)]
     pub fn update(&mut self, u: f32, y: f32) -> UpdateStatus {
-        self.update_with_heading(u, y, None)
+        self.update_inner(u, y, None)
     }
 
     /// One measurement update with command `u`, measured output `y` (NaN when missing) and,
@@ -321,53 +321,72 @@ impl<const N: usize> Predictor<N> {
     /// assert_eq!(p.state().psi, 91.0);
     /// assert_eq!(p.state().x, [0.5 + 0.5 * 2.0, 0.25 + 0.125 * 2.0]);
     /// ```
+    #[inline(never)]
     pub fn update_with_heading(&mut self, u: f32, y: f32, psi: Option<f32>) -> UpdateStatus {
-        let finite = y.is_finite();
+        self.update_inner(u, y, psi)
+    }
+
+    #[inline(always)]
+    fn update_inner(&mut self, u: f32, y: f32, psi: Option<f32>) -> UpdateStatus {
         if self.plain {
-            self.update_plain(u, y, finite, psi)
+            self.update_plain(u, y, psi)
         } else {
-            self.update_general(u, y, finite, psi)
-        }
-        let mut sum = self.st.x[0];
-        for xi in &self.st.x[1..] {
-            sum = sum + *xi;
-        }
-        sum = sum + self.st.psi;
-        if !sum.is_finite() {
-            self.st = PredictorState::ZERO;
-            UpdateStatus::NonFiniteReset
-        } else if finite {
-            UpdateStatus::Corrected
-        } else {
-            UpdateStatus::SkippedCorrection
+            self.update_general(u, y, psi)
         }
     }
 
-    /// The effect-free update: shift, one dot product, heading integration.
+    /// The effect-free update: shift, one dot product, heading integration. A missing
+    /// measurement takes the out-of-line path (same arithmetic with `e = 0`).
     #[inline(always)]
-    fn update_plain(&mut self, u: f32, y: f32, finite: bool, psi: Option<f32>) {
-        let st = &mut self.st;
-        let yhat = st.x[0];
-        let (y_used, e) = if finite { (y, y - yhat) } else { (yhat, 0.0) };
-        st.u_prev = u;
-        let x = st.x;
+    fn update_plain(&mut self, u: f32, y: f32, psi: Option<f32>) -> UpdateStatus {
+        if y.is_finite() {
+            let e = y - self.st.x[0];
+            self.plain_step(u, y, e, psi, UpdateStatus::Corrected)
+        } else {
+            self.plain_skip(u, psi)
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn plain_skip(&mut self, u: f32, psi: Option<f32>) -> UpdateStatus {
+        let yhat = self.st.x[0];
+        self.plain_step(u, yhat, 0.0, psi, UpdateStatus::SkippedCorrection)
+    }
+
+    #[inline(always)]
+    fn plain_step(
+        &mut self,
+        u: f32,
+        y_used: f32,
+        e: f32,
+        psi: Option<f32>,
+        ok: UpdateStatus,
+    ) -> UpdateStatus {
+        let x = self.st.x;
         let mut last = self.a[0] * x[0];
         for i in 1..N {
             last = last + self.a[i] * x[i];
         }
+        let mut nx = [0.0f32; N];
         for i in 0..N - 1 {
-            st.x[i] = x[i + 1] + self.b[i] * u + self.k[i] * e;
+            nx[i] = x[i + 1] + self.b[i] * u + self.k[i] * e;
         }
-        st.x[N - 1] = last + self.b[N - 1] * u + self.k[N - 1] * e;
+        nx[N - 1] = last + self.b[N - 1] * u + self.k[N - 1] * e;
         let heading = match psi {
             Some(p) if p.is_finite() => p,
-            _ => st.psi,
+            _ => self.st.psi,
         };
-        st.psi = heading + self.ts * y_used;
+        let npsi = heading + self.ts * y_used;
+        self.st.x = nx;
+        self.st.u_prev = u;
+        self.st.psi = npsi;
+        self.finish(&nx, npsi, ok)
     }
 
     #[inline(never)]
-    fn update_general(&mut self, u: f32, y: f32, finite: bool, psi: Option<f32>) {
+    fn update_general(&mut self, u: f32, y: f32, psi: Option<f32>) -> UpdateStatus {
+        let finite = y.is_finite();
         let mut st = self.st;
         let yhat = self.output(&st);
         let (y_used, e) = if finite { (y, y - yhat) } else { (yhat, 0.0) };
@@ -388,6 +407,34 @@ impl<const N: usize> Predictor<N> {
         st.x[N - 1] = last + self.b[N - 1] * v + self.k[N - 1] * e;
         st.psi = heading + self.ts * self.minus_dy(y_used);
         self.st = st;
+        let ok = if finite {
+            UpdateStatus::Corrected
+        } else {
+            UpdateStatus::SkippedCorrection
+        };
+        self.finish(&st.x, st.psi, ok)
+    }
+
+    /// Step 8: the finiteness check of the new state; `ok` is the status when it passes.
+    #[inline(always)]
+    fn finish(&mut self, x: &[f32; N], psi: f32, ok: UpdateStatus) -> UpdateStatus {
+        let mut sum = x[0];
+        for xi in &x[1..] {
+            sum = sum + *xi;
+        }
+        sum = sum + psi;
+        if sum.is_finite() {
+            ok
+        } else {
+            self.reset_non_finite()
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn reset_non_finite(&mut self) -> UpdateStatus {
+        self.st = PredictorState::ZERO;
+        UpdateStatus::NonFiniteReset
     }
 
     /// `x̂_1 + d_y` of a state (`x̂_1` without gyro bias).
@@ -494,6 +541,7 @@ impl<const N: usize> Predictor<N> {
     ///            Err(PredictorError::NotEnoughInputs { needed: 2, got: 1 }));
     /// # Ok::<(), PredictorError>(())
     /// ```
+    #[inline(never)]
     pub fn predict_into(&self, out: &mut [f32], future_u: &[f32]) -> Result<(), PredictorError> {
         let h = out.len();
         if h == 0 || h > MAX_HORIZON {
