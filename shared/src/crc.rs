@@ -27,6 +27,9 @@ const fn make_table() -> [u32; 256] {
 
 /// CRC-32 (IEEE) of `data`.
 ///
+/// # Errors
+/// None.
+///
 /// ```
 /// use yawcast_shared::crc::crc32;
 /// assert_eq!(crc32(b"123456789"), 0xCBF4_3926);

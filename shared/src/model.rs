@@ -291,6 +291,9 @@ pub enum Field {
 impl Field {
     /// The field's name as written in the model (`"a"`, `"b"`, `"k"`).
     ///
+    /// # Errors
+    /// None.
+    ///
     /// ```
     /// use yawcast_shared::model::Field;
     /// assert_eq!(Field::K.name(), "k");
@@ -488,19 +491,19 @@ impl ModelSpec {
                 return Err(ModelError::EffectParameter(kind));
             }
         }
-        let mut poly = [0.0f64; MAX_ORDER + 1];
-        companion_char_poly(&self.a, &[0.0; MAX_ORDER][..n], &mut poly[..=n]);
-        if !schur_stable(&poly[..=n]) {
+        if !schur_stable(&companion_char_poly(&self.a, &[], n), n) {
             return Err(ModelError::UnstableModel);
         }
-        companion_char_poly(&self.a, &self.k, &mut poly[..=n]);
-        if !schur_stable(&poly[..=n]) {
+        if !schur_stable(&companion_char_poly(&self.a, &self.k, n), n) {
             return Err(ModelError::UnstablePredictor);
         }
         Ok(())
     }
 
     /// The effect of the given kind, if the model carries one.
+    ///
+    /// # Errors
+    /// None: `None` means the model has no such effect.
     ///
     /// ```
     /// use yawcast_shared::model::{Effect, EffectKind, ModelSpec, Units};
@@ -537,46 +540,65 @@ fn effect_ok(e: &Effect) -> bool {
     }
 }
 
-/// Characteristic polynomial of `A − k e₁ᵀ` for the companion matrix with last row `a`,
-/// written monic in descending powers: `out = [1, c_1, …, c_n]` for `z^n + c_1 z^{n−1} + … + c_n`.
+/// A polynomial, monic, in descending powers: `[1, c_1, …, c_n, 0, …]` for
+/// `z^n + c_1 z^{n−1} + … + c_n`.
+type Poly = [f64; MAX_ORDER + 1];
+
+/// Characteristic polynomial of `A − k e₁ᵀ` for the order-`n` companion matrix with last row
+/// `a` (missing entries of `a` and `k` count as 0; `n` outside `1..=MAX_ORDER` gives NaNs).
 ///
 /// From `z x_i = x_{i+1} − k_i x_1` (i < n): `x_i = p_i(z) x_1` with `p_1 = 1`,
 /// `p_{i+1} = z p_i + k_i`; the last row gives `z p_n + k_n − Σ a_j p_j = 0`.
-/// With `k = 0` this is `z^n − a_n z^{n−1} − … − a_1`.
-fn companion_char_poly(a: &[f32], k: &[f32], out: &mut [f64]) {
-    let n = out.len() - 1;
+/// With `k = 0` this is `z^n − a_n z^{n−1} − … − a_1`. Fixed-size arrays throughout, so no
+/// index can fail.
+// Element loops over fixed arrays: every index is provably in bounds, no panic path.
+#[allow(clippy::manual_memcpy)]
+fn companion_char_poly(a: &[f32], k: &[f32], n: usize) -> Poly {
+    if n == 0 || n > MAX_ORDER {
+        // not a valid order: a polynomial that fails the stability test
+        return [f64::NAN; MAX_ORDER + 1];
+    }
+    let mut av = [0.0f64; MAX_ORDER];
+    let mut kv = [0.0f64; MAX_ORDER];
+    for (d, v) in av.iter_mut().zip(a).take(n) {
+        *d = f64::from(*v);
+    }
+    for (d, v) in kv.iter_mut().zip(k).take(n) {
+        *d = f64::from(*v);
+    }
     // p[i] holds p_{i+1} in ascending powers (p[i][j] = coefficient of z^j).
     let mut p = [[0.0f64; MAX_ORDER + 1]; MAX_ORDER];
     p[0][0] = 1.0;
     for i in 1..n {
-        let (prev, rest) = p.split_at_mut(i);
-        let cur = &mut rest[0];
-        let prev = &prev[i - 1];
-        for j in (1..=i).rev() {
-            cur[j] = prev[j - 1];
+        let prev = p[i - 1];
+        for j in 1..=i {
+            p[i][j] = prev[j - 1];
         }
-        cur[0] = f64::from(k[i - 1]);
+        p[i][0] = kv[i - 1];
     }
     // q(z) = z p_n + k_n − Σ a_j p_j, ascending powers, degree n.
     let mut q = [0.0f64; MAX_ORDER + 1];
-    q[1..=n].copy_from_slice(&p[n - 1][..n]);
-    q[0] += f64::from(k[n - 1]);
-    for (aj, pj) in a.iter().zip(p.iter()).take(n) {
+    for j in 0..n {
+        q[j + 1] = p[n - 1][j];
+    }
+    q[0] += kv[n - 1];
+    for j in 0..n {
         for m in 0..n {
-            q[m] -= f64::from(*aj) * pj[m];
+            q[m] -= av[j] * p[j][m];
         }
     }
-    for i in 0..=n {
-        out[i] = q[n - i];
+    let mut out = [0.0f64; MAX_ORDER + 1];
+    for (o, v) in out.iter_mut().zip(q.iter().take(n + 1).rev()) {
+        *o = *v;
     }
+    out
 }
 
 /// Schur–Cohn (Levinson step-down) test: `true` when every root of the monic polynomial
-/// `poly = [1, c_1, …, c_n]` (descending powers) lies strictly inside the unit circle.
-fn schur_stable(poly: &[f64]) -> bool {
-    let n = poly.len() - 1;
-    let mut c = [0.0f64; MAX_ORDER + 1];
-    c[..=n].copy_from_slice(poly);
+/// `poly` of degree `n` lies strictly inside the unit circle.
+fn schur_stable(poly: &Poly, n: usize) -> bool {
+    let n = n.min(MAX_ORDER);
+    let mut c = *poly;
     for m in (1..=n).rev() {
         let r = c[m];
         if !(r.is_finite() && r < 1.0 && r > -1.0) {
@@ -597,10 +619,14 @@ fn schur_stable(poly: &[f64]) -> bool {
 mod tests {
     use super::*;
 
-    fn poly_of(a: &[f32], k: &[f32]) -> [f64; MAX_ORDER + 1] {
-        let mut out = [0.0; MAX_ORDER + 1];
-        companion_char_poly(a, k, &mut out[..=a.len()]);
-        out
+    fn poly_of(a: &[f32], k: &[f32]) -> Poly {
+        companion_char_poly(a, k, a.len())
+    }
+
+    fn stable(c: &[f64]) -> bool {
+        let mut p = [0.0; MAX_ORDER + 1];
+        p[..c.len()].copy_from_slice(c);
+        schur_stable(&p, c.len() - 1)
     }
 
     #[test]
@@ -623,18 +649,18 @@ mod tests {
     #[test]
     fn schur_cohn_on_known_roots() {
         // (z − 0.9)(z + 0.8) = z² − 0.1 z − 0.72: stable.
-        assert!(schur_stable(&[1.0, -0.1, -0.72]));
+        assert!(stable(&[1.0, -0.1, -0.72]));
         // (z − 1.01)(z − 0.5) = z² − 1.51 z + 0.505: unstable.
-        assert!(!schur_stable(&[1.0, -1.51, 0.505]));
+        assert!(!stable(&[1.0, -1.51, 0.505]));
         // root exactly on the circle: z² − 1 is not strictly stable.
-        assert!(!schur_stable(&[1.0, 0.0, -1.0]));
+        assert!(!stable(&[1.0, 0.0, -1.0]));
         // complex pair 0.95 e^{±i 0.3}: z² − 1.9 cos(0.3) z + 0.9025.
-        assert!(schur_stable(&[1.0, -1.9 * 0.3f64.cos(), 0.9025]));
+        assert!(stable(&[1.0, -1.9 * 0.3f64.cos(), 0.9025]));
         // complex pair of modulus 1.05.
-        assert!(!schur_stable(&[1.0, -2.1 * 0.3f64.cos(), 1.1025]));
+        assert!(!stable(&[1.0, -2.1 * 0.3f64.cos(), 1.1025]));
         // (z − 0.5)^4 = z⁴ − 2 z³ + 1.5 z² − 0.5 z + 0.0625.
-        assert!(schur_stable(&[1.0, -2.0, 1.5, -0.5, 0.0625]));
-        assert!(!schur_stable(&[1.0, f64::NAN, 0.0]));
+        assert!(stable(&[1.0, -2.0, 1.5, -0.5, 0.0625]));
+        assert!(!stable(&[1.0, f64::NAN, 0.0]));
     }
 
     fn base() -> ModelSpec {

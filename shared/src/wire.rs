@@ -176,6 +176,9 @@ pub enum ErrorCode {
 impl ErrorCode {
     /// The numeric code (as sent on the wire).
     ///
+    /// # Errors
+    /// None.
+    ///
     /// ```
     /// use yawcast_shared::wire::ErrorCode;
     /// assert_eq!(ErrorCode::BlobBadCrc.code(), 8);
@@ -364,6 +367,9 @@ impl Default for FrameAccumulator {
 impl FrameAccumulator {
     /// An empty accumulator.
     ///
+    /// # Errors
+    /// None.
+    ///
     /// ```
     /// use yawcast_shared::wire::{Feed, FrameAccumulator};
     /// let mut acc = FrameAccumulator::new();
@@ -430,6 +436,9 @@ impl FrameAccumulator {
     }
 
     /// Drops any partly received frame.
+    ///
+    /// # Errors
+    /// None.
     ///
     /// ```
     /// use yawcast_shared::wire::{Feed, FrameAccumulator};

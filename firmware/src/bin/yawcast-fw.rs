@@ -115,13 +115,11 @@ mod app {
                 Ok(p) => {
                     self.predictor = Some(p);
                     self.sample = 0;
-                    let n = bytes.len();
-                    let crc = u32::from_le_bytes([
-                        bytes[n - 4],
-                        bytes[n - 3],
-                        bytes[n - 2],
-                        bytes[n - 1],
-                    ]);
+                    // a decoded blob ends with its 4-byte CRC
+                    let crc = match bytes.len().checked_sub(4).and_then(|i| bytes.get(i..)) {
+                        Some(&[b0, b1, b2, b3]) => u32::from_le_bytes([b0, b1, b2, b3]),
+                        _ => 0,
+                    };
                     let effects = spec.effects.len() as u8;
                     defmt::info!(
                         "model loaded: order {=u8}, {=u8} effects, crc {=u32:#010x}",
