@@ -1250,16 +1250,17 @@ def cmd_bench(args):
         print(msg, flush=True)
 
     yc = None
-    if not args.standin:
-        binary = yawcast_binary(args.yawcast, allow_debug=args.smoke)
-        if binary is None:
-            raise SystemExit("no yawcast binary: build it (cargo build --release) or pass --yawcast PATH, "
-                             "or run with --standin to exercise the peers alone")
+    binary = yawcast_binary(args.yawcast, allow_debug=args.smoke or args.standin)
+    if binary is None and not args.standin:
+        raise SystemExit("no yawcast binary: build it (cargo build --release) or pass --yawcast PATH, "
+                         "or run with --standin to exercise the peers alone")
+    if binary is not None and not args.no_yawcast:
         yc = Yawcast(binary, log)
         meta["yawcast"] = str(binary)
+    meta["records"] = "Python stand-in (run.py --standin)" if args.standin else "yawcast simulate"
     peers = args.peers.split(",") if args.peers else (["nfoursid"] if args.smoke else list(PEERS))
     say(f"suite: generating records in {work / 'data'}")
-    cases = build_suite(args, work, yc)
+    cases = build_suite(args, work, None if args.standin else yc)
     rows = []
     for i, case in enumerate(cases):
         mdir = work / "models" / case.effect / f"s{case.seed}"
@@ -1283,7 +1284,10 @@ def cmd_bench(args):
     meta["elapsed_s"] = time.perf_counter() - t_run
     meta["machine"]["load_at_end"] = [round(x, 2) for x in os.getloadavg()]
     (work / "results.json").write_text(json.dumps({"meta": meta, "rows": rows}, indent=1, default=str))
-    tools = peers + ([t for t in YAWCAST_TOOLS if any(r["tool"] == t for r in rows)] if yc else [])
+    # a yawcast tool that failed on every case (e.g. not in this build) is left out of the tables
+    tools = peers + [t for t in YAWCAST_TOOLS if any(r["tool"] == t and "error" not in r for r in rows)]
+    meta["dropped"] = {t: next(r["error"] for r in rows if r["tool"] == t) for t in YAWCAST_TOOLS
+                       if any(r["tool"] == t for r in rows) and t not in tools}
     report, verdicts = render(rows, tools, peers, cases, meta, args)
     for v in verdicts:
         say(v)
@@ -1520,6 +1524,11 @@ def notes(meta, args):
     if meta.get("compare_max_delta") is not None:
         N.append(f"- Cross-check: `yawcast compare --json` on the same models and records agrees with the shared "
                  f"predictor to {meta['compare_max_delta']:.2g} pp (largest difference over all yawcast rows).")
+    if meta.get("records", "").startswith("Python"):
+        N.append("- **Records from the Python stand-in, not from `yawcast simulate`** (a stable 4th-order innovations "
+                 "model driven by a PRBS, with toy versions of the effects).")
+    for t, err in (meta.get("dropped") or {}).items():
+        N.append(f"- {YAWCAST_LABEL.get(t, t)}: left out, it failed on every case ({err.replace(chr(96), chr(39))}).")
     N += ["- Whole-process times are single runs on a shared machine; the ratio column compares medians over "
           "the suite measured in the same run.", ""]
     N += ["Reproduce: `bench/peers/run.sh` (full run; `--smoke` for one record and one peer). Raw numbers per "
@@ -1548,6 +1557,7 @@ def main(argv=None):
         p.add_argument("--fresh", action="store_true", help="regenerate records that exist")
         p.add_argument("--no-ga", action="store_true", help="skip the GA-tuned yawcast")
         p.add_argument("--no-aug", action="store_true", help="skip diagnose + augment")
+        p.add_argument("--no-yawcast", action="store_true", help="peers only")
     f = sub.add_parser("fit", help="identify one model with one peer")
     f.add_argument("--peer", required=True, choices=list(PEERS))
     f.add_argument("--data", required=True)
