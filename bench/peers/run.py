@@ -1334,6 +1334,16 @@ def render(rows, tools, peers, cases, meta, args):
     m = meta["machine"]
     L.append("# yawcast against the peers: fit and identification time")
     L.append("")
+    missing = [YAWCAST_LABEL[t] for t in YAWCAST_TOOLS if t not in tools]
+    if meta.get("records", "").startswith("Python") or missing:
+        what = []
+        if meta.get("records", "").startswith("Python"):
+            what.append("the records come from the Python stand-in, not from the ship simulator")
+        if missing:
+            what.append("no numbers yet for: " + ", ".join(missing))
+        L.append(f"> **Provisional run:** {'; '.join(what)}. Rerun `bench/peers/run.sh` once the yawcast CLI "
+                 "has `simulate`, `identify`, `tune`, `diagnose` and `augment`.")
+        L.append("")
     L.append(f"Measured {meta['date']} at commit `{meta['commit']}` with `{meta['argv']}` "
              f"({meta['elapsed_s'] / 60:.1f} min for the whole run).")
     L.append("")
