@@ -7,5 +7,6 @@ pub mod demo;
 pub mod hil;
 pub mod model;
 pub mod nmea;
+pub mod pem;
 pub mod predict;
 pub mod report;
