@@ -4,6 +4,7 @@
 
 pub mod data;
 pub mod demo;
+pub mod ga;
 pub mod hil;
 pub mod model;
 pub mod nmea;

@@ -1,0 +1,978 @@
+//! Genetic-algorithm tuning of the regularisation (λ, R) — the paper's §2.4.
+//!
+//! Each individual codes λ and the diagonal of R as 13-bit genes (linear over
+//! [1e-8, 200] for R and [1e-8, 100] for λ, or log-scaled). Its fitness is the mean fit % of
+//! the k-step predictions (k = 5 and 10 by default) on the *trial* records of the model
+//! identified, with that (λ, R), on the *simulation* records; a model breaking the 10 % STD
+//! rule, unstable, or failing to identify is rejected (fitness −∞, counted by cause).
+//! Population 8, rank-based scaling with stochastic universal sampling, crossover
+//! probability 0.25 (randomly chosen genes exchanged), per-gene mutation probability 0.05
+//! (bit flips), one elite, stop at fit > 99.5 %, when the best fit moves less than 0.001 pp
+//! over `stall_generations`, or at the generation cap. The first population holds the
+//! conventional individual (λ = R = 1e-8), so the tuned model can only match or beat it.
+//! Evaluation is parallel (rayon) and memoised; the RNG is a seeded ChaCha8, so the same seed
+//! gives the same model.
+
+use std::collections::{BTreeMap, HashMap};
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::data::Record;
+use crate::model::Model;
+use crate::pem::{self, IdentError, PemConfig, PemReport};
+use crate::predict;
+
+/// How the models of several simulation records become one.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Combine {
+    /// One model per record, parameters averaged (the paper). The averaged model's STD is
+    /// `√(Σ σ²_i)/R` per parameter (independent experiments).
+    Average,
+    /// One multi-record identification (one cost, one x̂(0) per record).
+    Joint,
+}
+
+/// Settings of [`tune`]; `Default` holds the paper's values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GaConfig {
+    /// Individuals per generation (paper: 8).
+    pub population: usize,
+    /// Bits per gene (paper: 13).
+    pub bits: u32,
+    /// Range of each R_i (paper: [1e-8, 200]).
+    pub r_range: (f64, f64),
+    /// Range of λ (paper: [1e-8, 100]).
+    pub lambda_range: (f64, f64),
+    /// Crossover probability per pair (paper: 0.25).
+    pub crossover: f64,
+    /// Mutation probability per gene (paper: 0.05).
+    pub mutation: f64,
+    /// Best individuals copied unchanged into the next generation.
+    pub elite: usize,
+    /// Stop when the best fit exceeds this (paper: 99.5 %).
+    pub target_fit: f64,
+    /// Stop when the best fit moved less than this many percentage points … (paper: 0.001)
+    pub fit_tol: f64,
+    /// … over this many generations (the paper's rule read literally is 1; a plateau of one
+    /// generation is common with elitism, so the default waits for 10).
+    pub stall_generations: usize,
+    /// Generation cap.
+    pub max_generations: usize,
+    /// Prediction horizons of the fitness (mean fit over them and the trial records).
+    pub horizons: Vec<usize>,
+    /// Decode genes on a log scale instead of linearly.
+    pub log_scale: bool,
+    /// Grouped genes (R_a, R_b, R_k [, R_effects], λ) or one gene per parameter plus λ.
+    pub grouped: bool,
+    /// How several simulation records give one model.
+    pub combine: Combine,
+    /// STD% above which a candidate is rejected (paper: 10).
+    pub std_limit: f64,
+    /// RNG seed.
+    pub seed: u64,
+    /// Settings of the inner identifications (λ and R are set by the GA).
+    pub pem: PemConfig,
+    /// Show a progress bar on stderr (only drawn when stderr is a terminal).
+    pub progress: bool,
+}
+
+impl Default for GaConfig {
+    fn default() -> Self {
+        GaConfig {
+            population: 8,
+            bits: 13,
+            r_range: (1e-8, 200.0),
+            lambda_range: (1e-8, 100.0),
+            crossover: 0.25,
+            mutation: 0.05,
+            elite: 1,
+            target_fit: 99.5,
+            fit_tol: 0.001,
+            stall_generations: 10,
+            max_generations: 50,
+            horizons: vec![5, 10],
+            log_scale: false,
+            grouped: true,
+            combine: Combine::Average,
+            std_limit: pem::STD_PCT_UNRELIABLE,
+            seed: 0,
+            pem: PemConfig {
+                max_iter: 40,
+                tol: 1e-7,
+                parallel: false,
+                ..PemConfig::default()
+            },
+            progress: true,
+        }
+    }
+}
+
+/// Why the GA stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GaTermination {
+    /// The best fit exceeded the target.
+    FitTarget,
+    /// The best fit stopped improving (less than `fit_tol` over `stall_generations`).
+    Stalled,
+    /// The generation cap was reached.
+    MaxGenerations,
+}
+
+/// One generation's summary.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GenStats {
+    /// Generation number (1 = the initial population).
+    pub generation: usize,
+    /// Best fitness so far (−∞ while every candidate was rejected).
+    pub best_fit: f64,
+    /// Mean fitness of the accepted members of this generation.
+    pub mean_fit: f64,
+    /// Members of this generation that were rejected.
+    pub rejected: usize,
+    /// New (not memoised) evaluations in this generation.
+    pub evaluations: usize,
+}
+
+/// Rejected candidates by cause.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Rejections {
+    /// Broke the STD% rule.
+    pub std_rule: usize,
+    /// Unstable model (A, A − KC, or the averaged model).
+    pub unstable: usize,
+    /// Identification failed or predictions went non-finite.
+    pub failed: usize,
+}
+
+impl Rejections {
+    /// Total.
+    pub fn total(&self) -> usize {
+        self.std_rule + self.unstable + self.failed
+    }
+}
+
+/// A model and how it scores on the trial records.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Scored {
+    /// The (combined) model.
+    pub model: Model,
+    /// Mean fit % on the trial records per horizon (keys `"5"`, `"10"`, …).
+    pub fits: BTreeMap<String, f64>,
+    /// Fitness: the mean of `fits`.
+    pub fitness: f64,
+    /// STD per parameter of the (combined) model.
+    pub std: Vec<f64>,
+    /// STD% per parameter.
+    pub std_pct: Vec<f64>,
+}
+
+/// Result of [`tune`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GaReport {
+    /// The best (tuned) model.
+    pub best_model: Model,
+    /// Its λ.
+    pub lambda: f64,
+    /// Its R diagonal (one weight per parameter, `Model::param_names` order).
+    pub r: Vec<f64>,
+    /// Its genes (codes).
+    pub genes: Vec<u16>,
+    /// Its fitness (mean k-step fit % on the trials).
+    pub best_fit: f64,
+    /// The tuned model in detail.
+    pub tuned: Scored,
+    /// The conventional model (λ = 0) from the same records, for comparison; `None` when
+    /// its identification failed.
+    pub conventional: Option<Scored>,
+    /// Generations run.
+    pub generations: usize,
+    /// Per-generation summary.
+    pub history: Vec<GenStats>,
+    /// Distinct candidates evaluated.
+    pub evaluations: usize,
+    /// Distinct candidates rejected.
+    pub rejected: usize,
+    /// Rejections by cause.
+    pub rejected_by: Rejections,
+    /// Why the GA stopped.
+    pub termination: GaTermination,
+    /// The seed.
+    pub seed: u64,
+}
+
+/// GA errors.
+#[derive(Debug, Clone, Error, PartialEq)]
+#[non_exhaustive]
+pub enum GaError {
+    /// No simulation records.
+    #[error("no simulation records to identify from")]
+    NoSimulation,
+    /// No trial records.
+    #[error("no trial records to score on")]
+    NoTrials,
+    /// A setting is out of range.
+    #[error("bad GA setting: {0}")]
+    Config(String),
+    /// The conventional identification that seeds every search failed.
+    #[error("the conventional identification failed: {0}")]
+    Identification(#[from] IdentError),
+    /// Every candidate was rejected.
+    #[error(
+        "every one of the {evaluated} candidates was rejected — {cause} \
+         (STD rule {std_rule}, unstable {unstable}, failed {failed})"
+    )]
+    AllRejected {
+        /// Candidates evaluated.
+        evaluated: usize,
+        /// Broke the STD rule.
+        std_rule: usize,
+        /// Unstable.
+        unstable: usize,
+        /// Failed.
+        failed: usize,
+        /// The dominant cause, in words, with an example.
+        cause: String,
+    },
+}
+
+/// Decodes a gene code into `[lo, hi]`.
+///
+/// ```
+/// use yawcast::ga::decode;
+/// assert_eq!(decode(0, 13, (1e-8, 100.0), false), 1e-8);
+/// assert_eq!(decode(8191, 13, (1e-8, 100.0), false), 100.0);
+/// assert!((decode(8191, 13, (1e-8, 100.0), true) - 100.0).abs() < 1e-9);
+/// ```
+pub fn decode(code: u16, bits: u32, range: (f64, f64), log_scale: bool) -> f64 {
+    let max = ((1u32 << bits) - 1) as f64;
+    let f = f64::from(code) / max;
+    let (lo, hi) = range;
+    if f >= 1.0 {
+        return hi;
+    }
+    if f <= 0.0 {
+        return lo;
+    }
+    if log_scale {
+        lo * (hi / lo).powf(f)
+    } else {
+        lo + (hi - lo) * f
+    }
+}
+
+/// What the genes of a chromosome stand for.
+#[derive(Debug, Clone)]
+struct Genome {
+    /// For each parameter, the gene index of its R weight.
+    r_gene: Vec<usize>,
+    /// Gene index of λ.
+    lambda_gene: usize,
+    /// Genes in total.
+    len: usize,
+}
+
+impl Genome {
+    fn new(base: &Model, grouped: bool) -> Genome {
+        let n = base.n;
+        let p = 3 * n + base.effect_gains().len();
+        if grouped {
+            let has_effects = p > 3 * n;
+            let r_gene: Vec<usize> = (0..p).map(|i| if i < 3 * n { i / n } else { 3 }).collect();
+            let lambda_gene = if has_effects { 4 } else { 3 };
+            Genome {
+                r_gene,
+                lambda_gene,
+                len: lambda_gene + 1,
+            }
+        } else {
+            Genome {
+                r_gene: (0..p).collect(),
+                lambda_gene: p,
+                len: p + 1,
+            }
+        }
+    }
+
+    fn decode(&self, genes: &[u16], cfg: &GaConfig) -> (f64, Vec<f64>) {
+        let lambda = decode(
+            genes[self.lambda_gene],
+            cfg.bits,
+            cfg.lambda_range,
+            cfg.log_scale,
+        );
+        let r = self
+            .r_gene
+            .iter()
+            .map(|g| decode(genes[*g], cfg.bits, cfg.r_range, cfg.log_scale))
+            .collect();
+        (lambda, r)
+    }
+}
+
+/// The outcome of one candidate.
+#[derive(Debug, Clone)]
+enum Outcome {
+    Accepted(Scored),
+    StdRule { name: String, pct: f64 },
+    Unstable,
+    Failed(String),
+}
+
+impl Outcome {
+    fn fitness(&self) -> f64 {
+        match self {
+            Outcome::Accepted(s) => s.fitness,
+            _ => f64::NEG_INFINITY,
+        }
+    }
+}
+
+/// The fixed part of every evaluation.
+struct Ctx<'a> {
+    sim: &'a [Record],
+    trials: &'a [Record],
+    /// Warm starts: one per simulation record (Average) or one (Joint).
+    starts: Vec<Model>,
+    cfg: &'a GaConfig,
+}
+
+/// Combines per-record reports by averaging (see [`Combine::Average`]).
+fn average_reports(reps: &[PemReport]) -> (Model, Vec<f64>) {
+    let models: Vec<Model> = reps.iter().map(|r| r.model.clone()).collect();
+    let m = average_models(&models);
+    let count = reps.len() as f64;
+    let p = reps[0].std.len();
+    let std = (0..p)
+        .map(|j| reps.iter().map(|r| r.std[j] * r.std[j]).sum::<f64>().sqrt() / count)
+        .collect();
+    (m, std)
+}
+
+/// Parameter-wise mean of models of the same structure.
+fn average_models(models: &[Model]) -> Model {
+    let count = models.len() as f64;
+    let mut m = models[0].clone();
+    let mut th = vec![0.0; m.theta().len()];
+    let mut gains = vec![0.0; m.effect_gains().len()];
+    for x in models {
+        for (t, v) in th.iter_mut().zip(x.theta()) {
+            *t += v / count;
+        }
+        for (t, v) in gains.iter_mut().zip(x.effect_gains()) {
+            *t += v / count;
+        }
+    }
+    m.set_theta(&th);
+    m.set_effect_gains(&gains);
+    m
+}
+
+/// Mean fit per horizon on the trial records (x̂(0) estimated per record).
+fn trial_fits(model: &Model, trials: &[Record], horizons: &[usize]) -> BTreeMap<String, f64> {
+    let x0s: Vec<Vec<f64>> = trials
+        .iter()
+        .map(|r| predict::estimate_x0(model, r))
+        .collect();
+    horizons
+        .iter()
+        .map(|&k| {
+            let f = trials
+                .iter()
+                .zip(&x0s)
+                .map(|(r, x0)| predict::fit(&r.y, &predict::k_step(model, r, x0, k)))
+                .sum::<f64>()
+                / trials.len() as f64;
+            (k.to_string(), f)
+        })
+        .collect()
+}
+
+impl Ctx<'_> {
+    /// Identifies with (λ, R) and scores the model; `std_limit` applies.
+    fn evaluate(&self, lambda: f64, r: &[f64]) -> Outcome {
+        let pc = PemConfig {
+            lambda,
+            r: Some(r.to_vec()),
+            ..self.cfg.pem.clone()
+        };
+        let (model, std) = match self.cfg.combine {
+            Combine::Average => {
+                let mut reps = Vec::with_capacity(self.sim.len());
+                for (rec, start) in self.sim.iter().zip(&self.starts) {
+                    match pem::identify_from(std::slice::from_ref(rec), start, &pc) {
+                        Ok(rep) => reps.push(rep),
+                        Err(IdentError::Unstable) => return Outcome::Unstable,
+                        Err(e) => return Outcome::Failed(e.to_string()),
+                    }
+                }
+                average_reports(&reps)
+            }
+            Combine::Joint => match pem::identify_from(self.sim, &self.starts[0], &pc) {
+                Ok(rep) => (rep.model, rep.std),
+                Err(IdentError::Unstable) => return Outcome::Unstable,
+                Err(e) => return Outcome::Failed(e.to_string()),
+            },
+        };
+        score(model, std, self.trials, self.cfg)
+    }
+}
+
+/// Scores a model on the trials and applies the STD and stability rules.
+fn score(model: Model, std: Vec<f64>, trials: &[Record], cfg: &GaConfig) -> Outcome {
+    if !model.is_stable() {
+        return Outcome::Unstable;
+    }
+    let params = pem::params_of(&model);
+    let std_pct: Vec<f64> = std
+        .iter()
+        .zip(&params)
+        .map(|(s, v)| {
+            if *v == 0.0 {
+                f64::INFINITY
+            } else {
+                100.0 * s / v.abs()
+            }
+        })
+        .collect();
+    let names = model.param_names();
+    if let Some((i, pct)) = std_pct
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| v.is_nan() || **v > cfg.std_limit)
+        .max_by(|a, b| a.1.total_cmp(b.1))
+    {
+        return Outcome::StdRule {
+            name: names[i].clone(),
+            pct: *pct,
+        };
+    }
+    let fits = trial_fits(&model, trials, &cfg.horizons);
+    let fitness = fits.values().sum::<f64>() / fits.len().max(1) as f64;
+    if !fitness.is_finite() {
+        return Outcome::Failed("non-finite predictions on the trial records".into());
+    }
+    Outcome::Accepted(Scored {
+        model,
+        fits,
+        fitness,
+        std,
+        std_pct,
+    })
+}
+
+fn check(cfg: &GaConfig) -> Result<(), GaError> {
+    let bad = |m: &str| Err(GaError::Config(m.to_string()));
+    if cfg.population < 2 {
+        return bad("the population needs at least 2 individuals");
+    }
+    if !(1..=16).contains(&cfg.bits) {
+        return bad("bits per gene must be in 1..=16");
+    }
+    for (name, (lo, hi)) in [("R", cfg.r_range), ("λ", cfg.lambda_range)] {
+        if !(lo > 0.0 && hi > lo && hi.is_finite()) {
+            return Err(GaError::Config(format!(
+                "{name} range [{lo}, {hi}] must satisfy 0 < lo < hi < ∞"
+            )));
+        }
+    }
+    if !(0.0..=1.0).contains(&cfg.crossover) || !(0.0..=1.0).contains(&cfg.mutation) {
+        return bad("crossover and mutation probabilities must be in [0, 1]");
+    }
+    if cfg.elite >= cfg.population {
+        return bad("the elite must be smaller than the population");
+    }
+    if cfg.max_generations == 0 {
+        return bad("at least one generation is needed");
+    }
+    if cfg.horizons.is_empty() || cfg.horizons.contains(&0) {
+        return bad("horizons must be non-empty and ≥ 1");
+    }
+    Ok(())
+}
+
+/// Tunes (λ, R) on `trials` for models identified on `sim`, starting from `base` (its
+/// structure and parameters), with a progress bar on stderr when `cfg.progress` is set and
+/// stderr is a terminal.
+///
+/// # Errors
+/// [`GaError`] for missing records or bad settings, when the conventional identification on
+/// the simulation records fails, or when every candidate is rejected (the error names the
+/// dominant cause).
+pub fn tune(
+    sim: &[Record],
+    trials: &[Record],
+    base: &Model,
+    cfg: &GaConfig,
+) -> Result<GaReport, GaError> {
+    let bar = if cfg.progress {
+        let b = indicatif::ProgressBar::with_draw_target(
+            Some(cfg.max_generations as u64),
+            indicatif::ProgressDrawTarget::stderr(),
+        );
+        b.set_message(format!("GA (seed {})", cfg.seed));
+        Some(b)
+    } else {
+        None
+    };
+    let res = tune_with(sim, trials, base, cfg, &mut |g: &GenStats| {
+        if let Some(b) = &bar {
+            b.set_position(g.generation as u64);
+            b.set_message(format!(
+                "GA (seed {}): best fit {:.3} %",
+                cfg.seed, g.best_fit
+            ));
+        }
+    });
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    res
+}
+
+/// [`tune`] with a callback after every generation instead of the progress bar.
+///
+/// # Errors
+/// As [`tune`].
+pub fn tune_with(
+    sim: &[Record],
+    trials: &[Record],
+    base: &Model,
+    cfg: &GaConfig,
+    on_generation: &mut dyn FnMut(&GenStats),
+) -> Result<GaReport, GaError> {
+    if sim.is_empty() {
+        return Err(GaError::NoSimulation);
+    }
+    if trials.is_empty() {
+        return Err(GaError::NoTrials);
+    }
+    check(cfg)?;
+    // The conventional model(s): warm starts of every candidate and the reference.
+    let conv_cfg = PemConfig {
+        lambda: 0.0,
+        r: None,
+        ..cfg.pem.clone()
+    };
+    let conv_starts: Vec<PemReport> = match cfg.combine {
+        Combine::Average => sim
+            .par_iter()
+            .map(|r| pem::identify_from(std::slice::from_ref(r), base, &conv_cfg))
+            .collect::<Result<_, _>>()?,
+        Combine::Joint => vec![pem::identify_from(sim, base, &conv_cfg)?],
+    };
+    let conventional = {
+        let (m, std) = match cfg.combine {
+            Combine::Average => average_reports(&conv_starts),
+            Combine::Joint => (conv_starts[0].model.clone(), conv_starts[0].std.clone()),
+        };
+        // scored without the STD rule: it is the reference, shown whatever its STD%
+        let relaxed = GaConfig {
+            std_limit: f64::INFINITY,
+            ..cfg.clone()
+        };
+        match score(m, std, trials, &relaxed) {
+            Outcome::Accepted(s) => Some(s),
+            _ => None,
+        }
+    };
+    let ctx = Ctx {
+        sim,
+        trials,
+        starts: conv_starts.into_iter().map(|r| r.model).collect(),
+        cfg,
+    };
+    let genome = Genome::new(base, cfg.grouped);
+    let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
+    let max_code = ((1u32 << cfg.bits) - 1) as u16;
+    let mut pop: Vec<Vec<u16>> = Vec::with_capacity(cfg.population);
+    pop.push(vec![0; genome.len]); // the conventional individual
+    while pop.len() < cfg.population {
+        pop.push(
+            (0..genome.len)
+                .map(|_| rng.random_range(0..=max_code))
+                .collect(),
+        );
+    }
+    let mut memo: HashMap<Vec<u16>, Outcome> = HashMap::new();
+    let mut history: Vec<GenStats> = Vec::new();
+    let mut rejected_by = Rejections::default();
+    let mut example: Option<String> = None;
+    let mut best: Option<(Vec<u16>, f64)> = None;
+    let mut termination = GaTermination::MaxGenerations;
+    for generation in 1..=cfg.max_generations {
+        // evaluate the new chromosomes in parallel
+        let mut fresh: Vec<Vec<u16>> = pop
+            .iter()
+            .filter(|c| !memo.contains_key(*c))
+            .cloned()
+            .collect();
+        fresh.sort();
+        fresh.dedup();
+        let outcomes: Vec<Outcome> = fresh
+            .par_iter()
+            .map(|c| {
+                let (lambda, r) = genome.decode(c, cfg);
+                ctx.evaluate(lambda, &r)
+            })
+            .collect();
+        for (c, o) in fresh.iter().zip(outcomes) {
+            match &o {
+                Outcome::Accepted(_) => {}
+                Outcome::StdRule { name, pct } => {
+                    rejected_by.std_rule += 1;
+                    example.get_or_insert_with(|| format!("{name} has STD {pct:.1} %"));
+                }
+                Outcome::Unstable => rejected_by.unstable += 1,
+                Outcome::Failed(e) => {
+                    rejected_by.failed += 1;
+                    example.get_or_insert_with(|| e.clone());
+                }
+            }
+            memo.insert(c.clone(), o);
+        }
+        let fit: Vec<f64> = pop.iter().map(|c| memo[c].fitness()).collect();
+        for (c, f) in pop.iter().zip(&fit) {
+            if f.is_finite() && best.as_ref().map_or(true, |(_, b)| f > b) {
+                best = Some((c.clone(), *f));
+            }
+        }
+        let accepted: Vec<f64> = fit.iter().copied().filter(|f| f.is_finite()).collect();
+        let stats = GenStats {
+            generation,
+            best_fit: best.as_ref().map_or(f64::NEG_INFINITY, |b| b.1),
+            mean_fit: if accepted.is_empty() {
+                f64::NEG_INFINITY
+            } else {
+                accepted.iter().sum::<f64>() / accepted.len() as f64
+            },
+            rejected: fit.len() - accepted.len(),
+            evaluations: fresh.len(),
+        };
+        on_generation(&stats);
+        history.push(stats);
+        let best_now = history[generation - 1].best_fit;
+        if best_now > cfg.target_fit {
+            termination = GaTermination::FitTarget;
+            break;
+        }
+        if best_now.is_finite() && generation > cfg.stall_generations {
+            let before = history[generation - 1 - cfg.stall_generations].best_fit;
+            if before.is_finite() && (best_now - before).abs() < cfg.fit_tol {
+                termination = GaTermination::Stalled;
+                break;
+            }
+        }
+        if generation == cfg.max_generations {
+            break;
+        }
+        pop = next_generation(&pop, &fit, cfg, &mut rng);
+    }
+    let evaluations = memo.len();
+    let Some((genes, best_fit)) = best else {
+        return Err(all_rejected(evaluations, rejected_by, example));
+    };
+    let Some(Outcome::Accepted(tuned)) = memo.remove(&genes) else {
+        return Err(all_rejected(evaluations, rejected_by, example));
+    };
+    let (lambda, r) = genome.decode(&genes, cfg);
+    Ok(GaReport {
+        best_model: tuned.model.clone(),
+        lambda,
+        r,
+        genes,
+        best_fit,
+        tuned,
+        conventional,
+        generations: history.len(),
+        history,
+        evaluations,
+        rejected: rejected_by.total(),
+        rejected_by,
+        termination,
+        seed: cfg.seed,
+    })
+}
+
+fn all_rejected(evaluated: usize, by: Rejections, example: Option<String>) -> GaError {
+    let ex = example.unwrap_or_default();
+    let cause = if by.std_rule >= by.unstable && by.std_rule >= by.failed {
+        format!("the STD rule: parameters are not determined to the required precision (e.g. {ex}); more or richer simulation data, or a lower order, should help")
+    } else if by.unstable >= by.failed {
+        "the identified models are unstable".to_string()
+    } else {
+        format!("the identification failed ({ex})")
+    };
+    GaError::AllRejected {
+        evaluated,
+        std_rule: by.std_rule,
+        unstable: by.unstable,
+        failed: by.failed,
+        cause,
+    }
+}
+
+/// Selection (rank scaling, stochastic universal sampling), crossover, mutation, elitism.
+fn next_generation(
+    pop: &[Vec<u16>],
+    fit: &[f64],
+    cfg: &GaConfig,
+    rng: &mut ChaCha8Rng,
+) -> Vec<Vec<u16>> {
+    let size = pop.len();
+    let mut order: Vec<usize> = (0..size).collect();
+    order.sort_by(|a, b| fit[*b].total_cmp(&fit[*a]).then(a.cmp(b)));
+    // rank scaling 1/√rank; rejected members get no offspring (unless all are rejected)
+    let mut scaled = vec![0.0; size];
+    for (rank, &i) in order.iter().enumerate() {
+        if fit[i].is_finite() {
+            scaled[i] = 1.0 / ((rank + 1) as f64).sqrt();
+        }
+    }
+    if scaled.iter().all(|v| *v == 0.0) {
+        scaled.fill(1.0);
+    }
+    let mut next: Vec<Vec<u16>> = order[..cfg.elite].iter().map(|&i| pop[i].clone()).collect();
+    let children = size - cfg.elite;
+    // stochastic universal sampling
+    let total: f64 = scaled.iter().sum();
+    let step = total / children as f64;
+    let mut pointer = rng.random::<f64>() * step;
+    let mut parents = Vec::with_capacity(children);
+    let mut acc = 0.0;
+    let mut i = 0;
+    while parents.len() < children {
+        while acc + scaled[i] < pointer && i + 1 < size {
+            acc += scaled[i];
+            i += 1;
+        }
+        parents.push(pop[i].clone());
+        pointer += step;
+    }
+    // shuffle so that pairs mix
+    for j in (1..parents.len()).rev() {
+        let k = rng.random_range(0..=j);
+        parents.swap(j, k);
+    }
+    let len = pop[0].len();
+    let mut j = 0;
+    while j + 1 < parents.len() {
+        if rng.random::<f64>() < cfg.crossover {
+            let (a, b) = parents.split_at_mut(j + 1);
+            let (x, y) = (&mut a[j], &mut b[0]);
+            let mut swapped = false;
+            for g in 0..len {
+                if rng.random::<bool>() {
+                    std::mem::swap(&mut x[g], &mut y[g]);
+                    swapped = true;
+                }
+            }
+            if !swapped {
+                let g = rng.random_range(0..len);
+                std::mem::swap(&mut x[g], &mut y[g]);
+            }
+        }
+        j += 2;
+    }
+    for c in &mut parents {
+        for g in c.iter_mut() {
+            if rng.random::<f64>() < cfg.mutation {
+                let bit = rng.random_range(0..cfg.bits);
+                let mut v = *g ^ (1 << bit);
+                for b in 0..cfg.bits {
+                    if b != bit && rng.random::<f64>() < 1.0 / f64::from(cfg.bits) {
+                        v ^= 1 << b;
+                    }
+                }
+                *g = v;
+            }
+        }
+    }
+    next.extend(parents);
+    next
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::Effect;
+    use crate::pem::testdata;
+
+    /// Synthetic "simulator": the known 4th-order model; trials add a rate limit on the
+    /// pods (hidden) and more noise.
+    fn scenario(records: usize, len: usize) -> (Vec<Record>, Vec<Record>) {
+        let t = testdata::truth();
+        let hidden = t.clone().with_effect(Effect::RateLimit { rate: 3.0 });
+        let mut sim = Vec::new();
+        let mut trials = Vec::new();
+        for i in 0..records as u64 {
+            let mut rng = ChaCha8Rng::seed_from_u64(1000 + i);
+            let u = testdata::prbs(&mut rng, len, &[5.0, 10.0, 20.0]);
+            sim.push(testdata::simulate_innovations(
+                &t,
+                &u,
+                0.02,
+                &mut rng,
+                &format!("sim{i}"),
+                false,
+            ));
+            let mut rng = ChaCha8Rng::seed_from_u64(5000 + i);
+            let u = testdata::prbs(&mut rng, len, &[5.0, 10.0, 20.0]);
+            trials.push(testdata::simulate_innovations(
+                &hidden,
+                &u,
+                0.2,
+                &mut rng,
+                &format!("lake{i}"),
+                false,
+            ));
+        }
+        (sim, trials)
+    }
+
+    fn base(sim: &[Record]) -> Model {
+        pem::identify(sim, None, &PemConfig::default())
+            .unwrap()
+            .model
+    }
+
+    #[test]
+    fn decode_is_linear_or_logarithmic() {
+        let mid = decode(4096, 13, (1e-8, 200.0), false);
+        assert!((mid - 200.0 * 4096.0 / 8191.0).abs() < 1e-6);
+        let mid = decode(4096, 13, (1e-8, 100.0), true);
+        assert!((mid.log10() - (-8.0 + 10.0 * 4096.0 / 8191.0)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn genome_layouts() {
+        let m = testdata::truth();
+        let g = Genome::new(&m, true);
+        assert_eq!(g.len, 4);
+        assert_eq!(g.r_gene, vec![0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2]);
+        let g = Genome::new(&m, false);
+        assert_eq!(g.len, 13);
+        let m = m.with_effect(Effect::Bias { beta: 0.0 });
+        assert_eq!(Genome::new(&m, true).len, 5);
+    }
+
+    #[test]
+    fn short_run_is_reproducible_and_never_worse_than_conventional() {
+        let (sim, trials) = scenario(3, 400);
+        let b = base(&sim);
+        let cfg = GaConfig {
+            max_generations: 4,
+            progress: false,
+            seed: 7,
+            std_limit: f64::INFINITY,
+            ..GaConfig::default()
+        };
+        let a = tune(&sim, &trials, &b, &cfg).unwrap();
+        let c = tune(&sim, &trials, &b, &cfg).unwrap();
+        assert_eq!(a.best_model, c.best_model);
+        assert_eq!(a.genes, c.genes);
+        assert_eq!(a.history, c.history);
+        // elitism: the best never gets worse
+        for w in a.history.windows(2) {
+            assert!(w[1].best_fit >= w[0].best_fit);
+        }
+        let conv = a.conventional.as_ref().unwrap();
+        assert!(
+            a.best_fit >= conv.fitness - 1e-3,
+            "{} vs {}",
+            a.best_fit,
+            conv.fitness
+        );
+    }
+
+    #[test]
+    fn every_candidate_rejected_is_an_error_naming_the_cause() {
+        let (sim, trials) = scenario(2, 300);
+        let b = base(&sim);
+        let cfg = GaConfig {
+            max_generations: 2,
+            progress: false,
+            std_limit: 1e-9,
+            ..GaConfig::default()
+        };
+        let e = tune(&sim, &trials, &b, &cfg).unwrap_err();
+        assert!(
+            matches!(e, GaError::AllRejected { std_rule, .. } if std_rule > 0),
+            "{e}"
+        );
+        assert!(e.to_string().contains("STD rule"), "{e}");
+    }
+
+    #[test]
+    fn bad_settings_are_refused() {
+        let (sim, trials) = scenario(1, 300);
+        let b = base(&sim);
+        let cfg = GaConfig {
+            population: 1,
+            ..GaConfig::default()
+        };
+        assert!(matches!(
+            tune(&sim, &trials, &b, &cfg),
+            Err(GaError::Config(_))
+        ));
+        assert_eq!(
+            tune(&[], &trials, &b, &GaConfig::default()).unwrap_err(),
+            GaError::NoSimulation
+        );
+        assert_eq!(
+            tune(&sim, &[], &b, &GaConfig::default()).unwrap_err(),
+            GaError::NoTrials
+        );
+    }
+
+    /// 15 + 15 records: the tuned averaged model beats the conventional averaged model at 5
+    /// and 10 steps on the trials, and no tuned STD% exceeds 50.
+    #[test]
+    #[cfg_attr(debug_assertions, ignore = "heavy: run with --release")]
+    fn tuned_model_beats_conventional_on_trials_with_a_hidden_effect() {
+        let (sim, trials) = scenario(15, 1800);
+        let b = base(&sim);
+        let cfg = GaConfig {
+            progress: false,
+            seed: 1,
+            ..GaConfig::default()
+        };
+        let t0 = std::time::Instant::now();
+        let rep = tune(&sim, &trials, &b, &cfg).unwrap();
+        let conv = rep.conventional.clone().unwrap();
+        eprintln!(
+            "GA: {:.1} s, {} generations ({:?}), {} evaluations, {} rejected; λ = {:.4}, \
+             tuned {:?} vs conventional {:?}; tuned STD% {:?}; conventional STD% {:?}",
+            t0.elapsed().as_secs_f64(),
+            rep.generations,
+            rep.termination,
+            rep.evaluations,
+            rep.rejected,
+            rep.lambda,
+            rep.tuned.fits,
+            conv.fits,
+            rep.tuned.std_pct,
+            conv.std_pct
+        );
+        for k in ["5", "10"] {
+            assert!(
+                rep.tuned.fits[k] > conv.fits[k],
+                "{k}-step: tuned {} vs conventional {}",
+                rep.tuned.fits[k],
+                conv.fits[k]
+            );
+        }
+        assert!(
+            rep.tuned.std_pct.iter().all(|v| *v <= 50.0),
+            "{:?}",
+            rep.tuned.std_pct
+        );
+        let again = tune(&sim, &trials, &b, &cfg).unwrap();
+        assert_eq!(again.best_model, rep.best_model);
+    }
+}
