@@ -22,6 +22,7 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::data::Record;
+use crate::merge;
 use crate::model::Model;
 use crate::pem::{self, IdentError, PemConfig, PemReport};
 use crate::predict;
@@ -343,34 +344,11 @@ struct Ctx<'a> {
 }
 
 /// Combines per-record reports by averaging (see [`Combine::Average`]).
-fn average_reports(reps: &[PemReport]) -> (Model, Vec<f64>) {
+fn average_reports(reps: &[PemReport]) -> Result<(Model, Vec<f64>), String> {
     let models: Vec<Model> = reps.iter().map(|r| r.model.clone()).collect();
-    let m = average_models(&models);
-    let count = reps.len() as f64;
-    let p = reps[0].std.len();
-    let std = (0..p)
-        .map(|j| reps.iter().map(|r| r.std[j] * r.std[j]).sum::<f64>().sqrt() / count)
-        .collect();
-    (m, std)
-}
-
-/// Parameter-wise mean of models of the same structure.
-fn average_models(models: &[Model]) -> Model {
-    let count = models.len() as f64;
-    let mut m = models[0].clone();
-    let mut th = vec![0.0; m.theta().len()];
-    let mut gains = vec![0.0; m.effect_gains().len()];
-    for x in models {
-        for (t, v) in th.iter_mut().zip(x.theta()) {
-            *t += v / count;
-        }
-        for (t, v) in gains.iter_mut().zip(x.effect_gains()) {
-            *t += v / count;
-        }
-    }
-    m.set_theta(&th);
-    m.set_effect_gains(&gains);
-    m
+    let m = merge::average(&models).map_err(|e| e.to_string())?;
+    let std = merge::average_std(reps).map_err(|e| e.to_string())?;
+    Ok((m, std))
 }
 
 /// Mean fit per horizon on the trial records (x̂(0) estimated per record).
@@ -411,7 +389,10 @@ impl Ctx<'_> {
                         Err(e) => return Outcome::Failed(e.to_string()),
                     }
                 }
-                average_reports(&reps)
+                match average_reports(&reps) {
+                    Ok(v) => v,
+                    Err(e) => return Outcome::Failed(e),
+                }
             }
             Combine::Joint => match pem::identify_from(self.sim, &self.starts[0], &pc) {
                 Ok(rep) => (rep.model, rep.std),
@@ -568,7 +549,7 @@ pub fn tune_with(
     };
     let conventional = {
         let (m, std) = match cfg.combine {
-            Combine::Average => average_reports(&conv_starts),
+            Combine::Average => average_reports(&conv_starts).map_err(GaError::Config)?,
             Combine::Joint => (conv_starts[0].model.clone(), conv_starts[0].std.clone()),
         };
         // scored without the STD rule: it is the reference, shown whatever its STD%

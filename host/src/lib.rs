@@ -6,6 +6,7 @@ pub mod data;
 pub mod demo;
 pub mod ga;
 pub mod hil;
+pub mod merge;
 pub mod model;
 pub mod nmea;
 pub mod pem;
