@@ -4,6 +4,7 @@
 
 pub mod data;
 pub mod demo;
+pub mod export;
 pub mod ga;
 pub mod hil;
 pub mod merge;
