@@ -13,3 +13,4 @@ pub mod nmea;
 pub mod pem;
 pub mod predict;
 pub mod report;
+pub mod tables;
