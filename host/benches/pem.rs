@@ -35,7 +35,7 @@ fn record(seed: u64, len: usize) -> Record {
         let hold = rng.random_range(3..=15);
         let a = [5.0, 10.0, 20.0][rng.random_range(0..3)];
         let s = if rng.random::<bool>() { a } else { -a };
-        u.extend(std::iter::repeat_n(s, hold));
+        u.extend(std::iter::repeat(s).take(hold));
     }
     u.truncate(len);
     let s = Stepper::new(&m);
