@@ -1163,7 +1163,7 @@ def run_case_yawcast(yc, case, mdir, rows, args, log_print):
         ga = mdir / "yawcast-ga.postcard"
         row = {"case": case.name, "effect": case.effect, "seed": case.seed, "tool": "yawcast-ga"}
         try:
-            wall, t_in, _ = yc.tune(case.est, case.est, ga, seed)
+            wall, t_in, _ = yc.tune(case.ref, case.est, ga, seed)
             row.update(wall_s=wall, inproc_s=t_in, model=str(yc.twin(ga)))
         except Exception as e:  # noqa: BLE001
             row.update(error=str(e))
@@ -1525,7 +1525,7 @@ def notes(meta, args):
         "predictions fed back; the first 4 samples are the recursion's initial condition. Its block-wise "
         "`steps_ahead` is not used. Our recursion reproduces sysidentpy's own one-step and free-run "
         "predictions to 1e-8 (`run.py selftest`).",
-        "- yawcast: `identify` (plain PEM, λ = 0) on the estimation record; `tune` (GA over λ, R); `diagnose` "
+        "- yawcast: `identify` (plain PEM, λ = 0) on the estimation record; `tune` (GA over λ, R, the paper's recipe: PEM on the clean simulator's record, fitness = k-step fit on the estimation record as the trial); `diagnose` "
         "against the clean simulator's record, then `augment` with the diagnosed effect (a model with no verdict "
         "stays plain). Its models are read from the JSON twin (a, b, k and the effects) and scored by the same "
         "predictor, effects included (dead time → saturation → rate limit, bias, asymmetry, damping, heading "
