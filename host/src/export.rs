@@ -341,7 +341,10 @@ pub fn export_with(
             yawcast_firmware::MAX_HORIZON
         )));
     }
-    if check.len() < 2 * hmax + model.n || check.u.len() != check.len() {
+    if check.u.len() != check.len() || check.psi.as_ref().is_some_and(|p| p.len() != check.len()) {
+        return Err(bad("channel lengths differ".into()));
+    }
+    if check.len() < 2 * hmax + model.n {
         return Err(bad(format!(
             "{} samples; at least {} needed for horizon {hmax}",
             check.len(),

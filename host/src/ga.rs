@@ -220,6 +220,14 @@ pub enum GaError {
     /// A setting is out of range.
     #[error("bad GA setting: {0}")]
     Config(String),
+    /// A trial record cannot be scored.
+    #[error("trial record `{record}`: {what}")]
+    Trial {
+        /// Record name.
+        record: String,
+        /// What is wrong.
+        what: String,
+    },
     /// The conventional identification that seeds every search failed.
     #[error("the conventional identification failed: {0}")]
     Identification(#[from] IdentError),
@@ -447,6 +455,44 @@ fn score(model: Model, std: Vec<f64>, trials: &[Record], cfg: &GaConfig) -> Outc
     })
 }
 
+fn check_trials(trials: &[Record], ts: f64) -> Result<(), GaError> {
+    for r in trials {
+        let bad = |what: String| {
+            Err(GaError::Trial {
+                record: r.name.clone(),
+                what,
+            })
+        };
+        if r.u.len() != r.y.len() || r.psi.as_ref().is_some_and(|p| p.len() != r.y.len()) {
+            return bad(format!(
+                "channel lengths differ (u {}, y {})",
+                r.u.len(),
+                r.y.len()
+            ));
+        }
+        if r.len() < 2 {
+            return bad(format!("{} samples; at least 2 needed", r.len()));
+        }
+        if (r.ts - ts).abs() > 1e-9 * ts.abs() {
+            return bad(format!(
+                "sample time {} s, the simulation records have {ts} s",
+                r.ts
+            ));
+        }
+        let channels: [(&str, Option<&Vec<f64>>); 3] = [
+            ("u", Some(&r.u)),
+            ("y", Some(&r.y)),
+            ("psi", r.psi.as_ref()),
+        ];
+        for (name, v) in channels {
+            if let Some(i) = v.and_then(|v| v.iter().position(|x| !x.is_finite())) {
+                return bad(format!("{name} sample {i} is not finite"));
+            }
+        }
+    }
+    Ok(())
+}
+
 fn check(cfg: &GaConfig) -> Result<(), GaError> {
     let bad = |m: &str| Err(GaError::Config(m.to_string()));
     if cfg.population < 2 {
@@ -534,6 +580,7 @@ pub fn tune_with(
         return Err(GaError::NoTrials);
     }
     check(cfg)?;
+    check_trials(trials, sim[0].ts)?;
     // The conventional model(s): warm starts of every candidate and the reference.
     let conv_cfg = PemConfig {
         lambda: 0.0,
@@ -872,6 +919,28 @@ mod tests {
     }
 
     #[test]
+    fn joint_identification_mode_runs() {
+        let (sim, trials) = scenario(3, 400);
+        let b = base(&sim);
+        let cfg = GaConfig {
+            max_generations: 2,
+            progress: false,
+            combine: Combine::Joint,
+            grouped: false,
+            log_scale: true,
+            std_limit: f64::INFINITY,
+            ..GaConfig::default()
+        };
+        let mut seen = Vec::new();
+        let rep = tune_with(&sim, &trials, &b, &cfg, &mut |g| seen.push(g.generation)).unwrap();
+        assert_eq!(seen, vec![1, 2]);
+        assert_eq!(rep.genes.len(), 13);
+        assert_eq!(rep.r.len(), 12);
+        let conv = rep.conventional.as_ref().unwrap();
+        assert!(rep.best_fit >= conv.fitness - 1e-3);
+    }
+
+    #[test]
     fn every_candidate_rejected_is_an_error_naming_the_cause() {
         let (sim, trials) = scenario(2, 300);
         let b = base(&sim);
@@ -905,6 +974,13 @@ mod tests {
             tune(&[], &trials, &b, &GaConfig::default()).unwrap_err(),
             GaError::NoSimulation
         );
+        let mut bad = trials.clone();
+        bad[0].y[7] = f64::NAN;
+        let e = tune(&sim, &bad, &b, &GaConfig::default()).unwrap_err();
+        assert!(e.to_string().contains("y sample 7 is not finite"), "{e}");
+        bad[0].y.pop();
+        let e = tune(&sim, &bad, &b, &GaConfig::default()).unwrap_err();
+        assert!(e.to_string().contains("lengths differ"), "{e}");
         assert_eq!(
             tune(&sim, &[], &b, &GaConfig::default()).unwrap_err(),
             GaError::NoTrials
