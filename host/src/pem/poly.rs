@@ -71,7 +71,23 @@ pub(crate) fn schur_stable(p: &[f64], n: usize) -> bool {
     true
 }
 
-/// Whether A and A − KC of the canonical model (a, k) are both strictly stable.
+/// Largest root modulus the search accepts: a margin below 1 keeps the optimum away from the
+/// unit circle, where rounding could tip an eigenvalue check either way.
+pub(crate) const MAX_RADIUS: f64 = 1.0 - 1e-7;
+
+/// Whether every root of `p[..=n]` has modulus below `radius` (Schur–Cohn on `p(radius·z)`).
+pub(crate) fn roots_within(p: &[f64], n: usize, radius: f64) -> bool {
+    let mut q = [0.0f64; MAX_N + 1];
+    let mut scale = 1.0;
+    for i in (0..=n).rev() {
+        q[i] = p[i] * scale;
+        scale *= radius;
+    }
+    schur_stable(&q, n)
+}
+
+/// Whether A and A − KC of the canonical model (a, k) have every eigenvalue inside
+/// [`MAX_RADIUS`].
 pub(crate) fn canonical_stable(a: &[f64], k: &[f64]) -> bool {
     let n = a.len();
     if n == 0 || n > MAX_N {
@@ -79,11 +95,11 @@ pub(crate) fn canonical_stable(a: &[f64], k: &[f64]) -> bool {
     }
     let mut p = [0.0; MAX_N + 1];
     a_poly(a, &mut p);
-    if !schur_stable(&p, n) {
+    if !roots_within(&p, n, MAX_RADIUS) {
         return false;
     }
     predictor_poly(a, k, &mut p);
-    schur_stable(&p, n)
+    roots_within(&p, n, MAX_RADIUS)
 }
 
 /// Roots of a polynomial (highest power first, leading coefficient non-zero).
@@ -235,6 +251,14 @@ mod tests {
             agree += 1;
         }
         assert_eq!(agree, 400);
+    }
+
+    #[test]
+    fn radius_margin() {
+        // (z − 0.5)(z + 0.9): inside 0.95, not inside 0.85
+        let p = [1.0, 0.4, -0.45];
+        assert!(roots_within(&p, 2, 0.95));
+        assert!(!roots_within(&p, 2, 0.85));
     }
 
     #[test]
