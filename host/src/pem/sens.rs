@@ -117,7 +117,7 @@ pub(crate) fn with_params(template: &Model, params: &[f64]) -> Model {
 }
 
 /// Receives, for each sample with a measured y, the one-step error ε = y − ŷ and the row
-/// ∂ŷ/∂(θ, x̂(0)).
+/// ∂ŷ/∂(θ, x̂(0)); a row shorter than the layout's `q` has zeros in its missing entries.
 pub(crate) trait Sink {
     /// One sample.
     fn sample(&mut self, e: f64, row: &[f64]);
@@ -165,16 +165,17 @@ impl Sink for Accum {
     #[inline]
     fn sample(&mut self, e: f64, row: &[f64]) {
         let q = self.q;
+        let len = row.len().min(q);
         self.sse += e * e;
         self.count += 1;
-        for i in 0..q {
+        for i in 0..len {
             let ri = row[i];
             if ri == 0.0 {
                 continue;
             }
             self.g[i] += ri * e;
-            let h = &mut self.h[i * q + i..i * q + q];
-            for (hj, rj) in h.iter_mut().zip(&row[i..q]) {
+            let h = &mut self.h[i * q + i..i * q + len];
+            for (hj, rj) in h.iter_mut().zip(&row[i..len]) {
                 *hj += ri * rj;
             }
         }
@@ -214,6 +215,9 @@ pub(crate) fn sse(model: &Model, rec: &Record, x0: &[f64]) -> SseOnly {
     out
 }
 
+/// Size below which the x̂(0) sensitivities (which start at 1) are dropped.
+const X0_CUTOFF: f64 = 1e-30;
+
 /// Runs the one-step predictor of `model` (structure `lay`) on `rec` from x̂(0) = `x0` and
 /// feeds every measured sample's error and sensitivity row to `sink`.
 pub(crate) fn pass<S: Sink>(model: &Model, lay: &Layout, rec: &Record, x0: &[f64], sink: &mut S) {
@@ -249,6 +253,7 @@ pub(crate) fn pass<S: Sink>(model: &Model, lay: &Layout, rec: &Record, x0: &[f64
     }
     let mut spsi = vec![0.0f64; q];
     let mut row = vec![0.0f64; q];
+    let mut active = q;
     let mut phi = vec![0.0f64; lay.gains.len()];
     for t in 0..rec.len() {
         let x = st.x;
@@ -300,7 +305,7 @@ pub(crate) fn pass<S: Sink>(model: &Model, lay: &Layout, rec: &Record, x0: &[f64
         } else {
             0.0
         };
-        for j in 0..q {
+        for j in 0..active {
             let sj = sx[j];
             let ddy = if j == dy_col { 1.0 } else { 0.0 };
             let dyhat = sj[0] + ddy;
@@ -336,7 +341,19 @@ pub(crate) fn pass<S: Sink>(model: &Model, lay: &Layout, rec: &Record, x0: &[f64
             }
         }
         if yfin {
-            sink.sample(e, &row);
+            sink.sample(e, &row[..active]);
+        }
+        // The x̂(0) sensitivities decay with A − KC; once negligible they are exactly zero
+        // from then on and need no more work.
+        if active == q && t % 8 == 7 {
+            let mut m = 0.0f64;
+            for j in p..q {
+                m = sx[j][..n].iter().fold(m, |m, v| m.max(v.abs()));
+                m = m.max(spsi[j].abs());
+            }
+            if m < X0_CUTOFF {
+                active = p;
+            }
         }
     }
 }
@@ -425,10 +442,13 @@ pub(crate) mod tests {
             let base = if j < lay.p { params[j] } else { x0[j - lay.p] };
             let h = 1e-5 * base.abs().max(1e-2);
             let (yp, ym) = (eval(h), eval(-h));
-            let scale = rows.rows.iter().map(|r| r[j].abs()).fold(1e-3, f64::max);
+            let at = |r: usize| rows.rows[r].get(j).copied().unwrap_or(0.0);
+            let scale = (0..rows.rows.len())
+                .map(|r| at(r).abs())
+                .fold(1e-3, f64::max);
             for (r, t) in idx.iter().enumerate() {
                 let fd = (yp[*t] - ym[*t]) / (2.0 * h);
-                let err = (fd - rows.rows[r][j]).abs() / scale;
+                let err = (fd - at(r)).abs() / scale;
                 worst = worst.max(err);
             }
         }
