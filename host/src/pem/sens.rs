@@ -221,12 +221,36 @@ const X0_CUTOFF: f64 = 1e-30;
 /// Runs the one-step predictor of `model` (structure `lay`) on `rec` from x̂(0) = `x0` and
 /// feeds every measured sample's error and sensitivity row to `sink`.
 pub(crate) fn pass<S: Sink>(model: &Model, lay: &Layout, rec: &Record, x0: &[f64], sink: &mut S) {
-    let n = lay.n;
+    // One copy per order, so that the loops over the state have constant length.
+    match lay.n {
+        2 => pass_n::<2, S>(model, lay, rec, x0, sink),
+        3 => pass_n::<3, S>(model, lay, rec, x0, sink),
+        4 => pass_n::<4, S>(model, lay, rec, x0, sink),
+        5 => pass_n::<5, S>(model, lay, rec, x0, sink),
+        6 => pass_n::<6, S>(model, lay, rec, x0, sink),
+        7 => pass_n::<7, S>(model, lay, rec, x0, sink),
+        _ => pass_n::<MAX_N, S>(model, lay, rec, x0, sink),
+    }
+}
+
+fn pass_n<const N: usize, S: Sink>(
+    model: &Model,
+    lay: &Layout,
+    rec: &Record,
+    x0: &[f64],
+    sink: &mut S,
+) {
+    let n = N;
     let p = lay.p;
     let q = lay.q();
     let nt = 3 * n;
     let stepper = Stepper::new(model);
-    let (a, b, k) = (&model.a[..n], &model.b[..n], &model.k[..n]);
+    let arr = |v: &[f64]| {
+        let mut o = [0.0f64; N];
+        o.copy_from_slice(&v[..N]);
+        o
+    };
+    let (a, b, k) = (arr(&model.a), arr(&model.b), arr(&model.k));
     let ts = model.ts;
     let gains = model.effect_gains();
     // β of damping and of the heading regressors, for the y and ψ partials of v.
@@ -247,7 +271,7 @@ pub(crate) fn pass<S: Sink>(model: &Model, lay: &Layout, rec: &Record, x0: &[f64
     let dy_col = lay.dy.unwrap_or(usize::MAX);
     let mut st = stepper.initial(x0, psi_at(rec, 0).unwrap_or(0.0));
     // Sensitivities of x̂ (and of ψ̂) to each column.
-    let mut sx = vec![[0.0f64; MAX_N]; q];
+    let mut sx = vec![[0.0f64; N]; q];
     for i in 0..n {
         sx[p + i][i] = 1.0;
     }
