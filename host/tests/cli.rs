@@ -393,3 +393,203 @@ fn hil_in_qemu_is_bit_exact() {
     assert_ne!(code(&o), 0);
     assert!(stderr(&o).contains("order"), "{}", stderr(&o));
 }
+
+/// Issue 5's acceptance: five seeds, each run of the demo names the hidden effect, the tuned
+/// model beats the conventional one at 5 steps, augmentation does not lose at 10 steps, and
+/// the firmware is bit-exact. Release builds only (each run is a full pipeline); the seeds
+/// run in parallel threads.
+#[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "release-mode test: run with cargo test --release"
+)]
+fn demo_five_seeds_acceptance() {
+    let d = scratch("demo5");
+    let seeds = [1u64, 2, 3, 4, 5];
+    let handles: Vec<_> = seeds
+        .iter()
+        .map(|&seed| {
+            let out = d.join(format!("demo-{seed}"));
+            std::thread::spawn(move || {
+                let json = out.join("summary-test.json");
+                let o = run(&[
+                    "demo",
+                    "--seed",
+                    &seed.to_string(),
+                    "--out",
+                    out.to_str().unwrap(),
+                    "--json",
+                    json.to_str().unwrap(),
+                ]);
+                (seed, o, json)
+            })
+        })
+        .collect();
+    let mut lines = Vec::new();
+    let mut failures = Vec::new();
+    for h in handles {
+        let (seed, o, json) = h.join().unwrap();
+        assert_eq!(code(&o), 0, "seed {seed}: {}\n{}", stdout(&o), stderr(&o));
+        let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+        let fit = |m: &str, h: &str| v[m]["fit"][h].as_f64().unwrap_or(f64::NAN);
+        lines.push(format!(
+            "seed {seed}: hidden {} diagnosed {} | conv@5 {:.2} tuned@5 {:.2} | tuned@10 {:.2} aug@10 {:.2} | bit-exact {} | {:.1} s",
+            v["hidden_effect"], v["diagnosed_effect"], fit("conventional", "5"), fit("tuned", "5"),
+            fit("tuned", "10"), fit("augmented", "10"), v["firmware_bit_exact"], v["seconds"].as_f64().unwrap_or(f64::NAN)
+        ));
+        if v["diagnosed_effect"] != v["hidden_effect"] {
+            failures.push(format!("seed {seed}: diagnosis wrong"));
+        }
+        let tuned_wins = fit("tuned", "5") > fit("conventional", "5");
+        if !tuned_wins {
+            failures.push(format!(
+                "seed {seed}: tuned does not beat conventional at 5 steps"
+            ));
+        }
+        let aug_holds = fit("augmented", "10") >= fit("tuned", "10");
+        if !aug_holds {
+            failures.push(format!("seed {seed}: augmented loses at 10 steps"));
+        }
+        if v["firmware_bit_exact"] != true {
+            failures.push(format!("seed {seed}: firmware not bit-exact"));
+        }
+        for k in [
+            "seed",
+            "hidden_effect",
+            "diagnosed_effect",
+            "firmware_bit_exact",
+            "seconds",
+        ] {
+            assert!(
+                v.get(k).is_some(),
+                "seed {seed}: `{k}` missing from the summary"
+            );
+        }
+        assert!(json.parent().unwrap().join("report.html").is_file());
+    }
+    println!("{}", lines.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "{}\n{}",
+        failures.join("\n"),
+        lines.join("\n")
+    );
+}
+
+/// A 4th-order record with noise, deterministic.
+fn csv4(n: usize, seed: u64, noise: f64) -> String {
+    let a = [-0.086_45, 0.6135, -1.785, 2.25];
+    let b = [0.02, 0.035, 0.045, 0.05];
+    let mut s = seed
+        .wrapping_mul(2_862_933_555_777_941_757)
+        .wrapping_add(3_037_000_493);
+    let mut next = || {
+        s = s
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut x = [0.0f64; 4];
+    let mut u = 10.0;
+    let mut out = String::from("t_s,delta_deg,r_degps\n");
+    for t in 0..n {
+        if t % 9 == 0 {
+            u = [-20.0, -10.0, 10.0, 20.0][(next() * 4.0) as usize % 4];
+        }
+        let y = x[0] + noise * (next() - 0.5);
+        out.push_str(&format!("{},{},{:.6}\n", t as f64 * 0.5, u, y));
+        let x4 = a[0] * x[0] + a[1] * x[1] + a[2] * x[2] + a[3] * x[3] + b[3] * u;
+        x = [x[1] + b[0] * u, x[2] + b[1] * u, x[3] + b[2] * u, x4];
+    }
+    out
+}
+
+#[test]
+fn identify_average_export_compare_chain() {
+    let d = scratch("chain");
+    for (name, seed, noise) in [("s0", 1, 0.02), ("s1", 2, 0.02), ("t0", 3, 0.05)] {
+        std::fs::write(d.join(format!("{name}.csv")), csv4(500, seed, noise)).unwrap();
+    }
+    let p = |f: &str| d.join(f).to_str().unwrap().to_string();
+    let o = run(&[
+        "identify",
+        "--data",
+        &p("s0.csv"),
+        "--validate",
+        &p("t0.csv"),
+        "--out",
+        &p("m"),
+        "--json",
+        &p("id.json"),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(d.join("m.postcard").is_file() && d.join("m.json").is_file());
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("id.json")).unwrap()).unwrap();
+    for k in [
+        "order",
+        "names",
+        "values",
+        "std_pct",
+        "reliability",
+        "aic",
+        "bic",
+        "fit",
+    ] {
+        assert!(v.get(k).is_some(), "identify JSON lacks `{k}`");
+    }
+    assert!(v["fit"]["5"].as_f64().unwrap() > 95.0, "{v}");
+
+    let o = run(&[
+        "average",
+        "--data",
+        &p("s0.csv"),
+        "--data",
+        &p("s1.csv"),
+        "--validate",
+        &p("t0.csv"),
+        "--out",
+        &p("avg"),
+        "--json",
+        &p("avg-summary.json"),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("avg-summary.json")).unwrap()).unwrap();
+    assert!(v["combinations"][0]["fit"]["10"].is_f64());
+
+    let o = run(&[
+        "export",
+        "--model",
+        &p("avg.json"),
+        "--data",
+        &p("t0.csv"),
+        "--out",
+        &p("ctl/model"),
+        "--json",
+        &p("exp.json"),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let o = run(&[
+        "compare",
+        "--model",
+        &p("ctl/model.postcard"),
+        "--data",
+        &p("t0.csv"),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+
+    // Bad input: an order range outside 2..=8, a constant input.
+    let o = run(&["identify", "--data", &p("s0.csv"), "--orders", "1..9"]);
+    assert_eq!(code(&o), 2);
+    assert!(stderr(&o).contains("--orders"), "{}", stderr(&o));
+    let mut flat = String::from("t_s,delta_deg,r_degps\n");
+    for t in 0..200 {
+        flat.push_str(&format!("{},5,0.1\n", f64::from(t) * 0.5));
+    }
+    std::fs::write(d.join("flat.csv"), flat).unwrap();
+    let o = run(&["identify", "--data", &p("flat.csv"), "--out", &p("never")]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("constant"), "{}", stderr(&o));
+    assert!(!d.join("never.postcard").exists());
+}

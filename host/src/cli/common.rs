@@ -195,6 +195,11 @@ impl ReadArgs {
             Ok(data::parse_csv(&text, path, &name, &self.columns())?)
         }
     }
+
+    /// Reads several record files, in order.
+    pub fn read_all(&self, paths: &[PathBuf]) -> Result<Vec<Record>> {
+        paths.iter().map(|p| self.read(p)).collect()
+    }
 }
 
 /// `--json FILE`: where the machine-readable summary goes.
@@ -231,7 +236,6 @@ pub struct SeedArg {
     pub seed: Option<u64>,
 }
 
-#[allow(dead_code)] // wired into the random commands as their libraries land
 impl SeedArg {
     /// The seed to use: the given one, or one drawn from the clock. Printed on stderr.
     pub fn resolve(&self) -> u64 {
@@ -248,7 +252,6 @@ impl SeedArg {
 }
 
 /// A progress bar on stderr (hidden when stderr is not a terminal).
-#[allow(dead_code)] // wired into the long commands as their libraries land
 pub fn progress(len: u64, msg: &str) -> indicatif::ProgressBar {
     let pb = indicatif::ProgressBar::with_draw_target(
         Some(len),

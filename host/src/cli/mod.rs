@@ -6,6 +6,7 @@ use clap::{Parser, Subcommand};
 pub mod common;
 pub mod compare;
 pub mod hil;
+pub mod pipeline;
 
 /// yawcast — ship trials to a yaw-rate predictor that runs on the ship's controller.
 ///
@@ -26,13 +27,13 @@ pub enum Command {
     /// Simulate records of the built-in (or your) ship: identification inputs, trials, manoeuvres.
     Simulate(Pending),
     /// Identify a model from records (prediction-error method), or select the order.
-    Identify(Pending),
+    Identify(pipeline::IdentifyArgs),
     /// Tune the regularisation (λ, R) with the genetic algorithm, scored on trial records.
-    Tune(Pending),
+    Tune(pipeline::TuneArgs),
     /// Combine several models: plain average, covariance-weighted merge, multi-record PEM.
-    Average(Pending),
+    Average(pipeline::AverageArgs),
     /// Export a model as the firmware blob (+ JSON twin), checked through the firmware predictor.
-    Export(Pending),
+    Export(pipeline::ExportArgs),
     /// Fit % of a model on records per horizon; measured vs predicted series.
     Compare(compare::CompareArgs),
     /// Which physical effect is missing from the model? Evidence for every effect, and a verdict.
@@ -75,6 +76,10 @@ pub fn run(cli: Cli) -> Result<()> {
     match &cli.command {
         Command::Compare(a) => compare::run(a),
         Command::Hil(a) => hil::run(a),
+        Command::Identify(a) => pipeline::identify(a),
+        Command::Tune(a) => pipeline::tune(a),
+        Command::Average(a) => pipeline::average(a),
+        Command::Export(a) => pipeline::export_cmd(a),
         other => anyhow::bail!("`yawcast {}` is not available in this build", other.name()),
     }
 }

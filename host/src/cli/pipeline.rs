@@ -1,0 +1,553 @@
+//! `yawcast identify`, `tune`, `average` and `export`: the paper's pipeline on the command line.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use clap::{Args, ValueEnum};
+use serde::Serialize;
+use yawcast::data::Record;
+use yawcast::model::Model;
+use yawcast::{export, ga, merge, pem, tables};
+
+use super::common::{bad, read_model, JsonArg, ReadArgs, SeedArg};
+
+/// Reads every path of a repeatable option, naming the option when none was given.
+fn read_records(read: &ReadArgs, paths: &[PathBuf], option: &str) -> Result<Vec<Record>> {
+    if paths.is_empty() {
+        return Err(bad(format!("no {option} FILE given")));
+    }
+    paths
+        .iter()
+        .map(|p| read.read(p))
+        .collect::<Result<Vec<_>>>()
+}
+
+/// Exports `model` as `<out>.postcard` + `<out>.json`, checked through the firmware on `check`.
+fn write_model(model: &Model, out: &Path, check: &Record) -> Result<export::ExportReport> {
+    export::export(model, out, check)
+        .with_context(|| format!("writing the model {}", out.display()))
+}
+
+fn print_params(names: &[String], theta: &[f64], std_pct: &[f64]) {
+    println!("{:<22} {:>14} {:>9}", "parameter", "value", "STD %");
+    for (i, n) in names.iter().enumerate() {
+        let v = theta.get(i).copied().unwrap_or(f64::NAN);
+        let s = std_pct.get(i).copied().unwrap_or(f64::NAN);
+        let flag = if s > 50.0 {
+            "  unusable"
+        } else if s > 10.0 {
+            "  unreliable"
+        } else {
+            ""
+        };
+        println!("{n:<22} {v:>14.6} {s:>9.2}{flag}");
+    }
+}
+
+fn all_params(m: &Model) -> Vec<f64> {
+    let mut v = m.theta();
+    v.extend(m.effect_gains());
+    v
+}
+
+fn parse_orders(s: &str) -> Result<Vec<usize>> {
+    let err = || {
+        bad(format!(
+            "--orders `{s}`: expected a range like 2..6 or a list like 2,4,6"
+        ))
+    };
+    let v: Vec<usize> = if let Some((a, b)) = s.split_once("..") {
+        let a: usize = a.trim().parse().map_err(|_| err())?;
+        let b: usize = b
+            .trim_start_matches('=')
+            .trim()
+            .parse()
+            .map_err(|_| err())?;
+        (a..=b).collect()
+    } else {
+        s.split(',')
+            .map(|x| x.trim().parse().map_err(|_| err()))
+            .collect::<Result<_>>()?
+    };
+    if v.is_empty() || v.iter().any(|n| !(2..=8).contains(n)) {
+        return Err(bad(format!("--orders `{s}`: orders must lie in 2..=8")));
+    }
+    Ok(v)
+}
+
+/// Arguments of `yawcast identify`.
+#[derive(Debug, Args)]
+pub struct IdentifyArgs {
+    /// Records to identify from (CSV or NMEA); repeatable (one multi-record identification).
+    #[arg(long, value_name = "FILE", required = true)]
+    pub data: Vec<PathBuf>,
+    /// Records to validate on (fit per horizon); repeatable.
+    #[arg(long, value_name = "FILE")]
+    pub validate: Vec<PathBuf>,
+    /// Model order n.
+    #[arg(long, default_value_t = 4, value_name = "N")]
+    pub order: usize,
+    /// Order selection instead: identify each order (e.g. `2..6`) and report fit, AIC, BIC.
+    #[arg(long, value_name = "RANGE")]
+    pub orders: Option<String>,
+    /// Regularisation weight λ (0: plain PEM); R is the identity.
+    #[arg(long, default_value_t = 0.0, value_name = "LAMBDA")]
+    pub lambda: f64,
+    /// Where the model goes: `<PATH>.postcard` and its `<PATH>.json` twin.
+    #[arg(long, value_name = "PATH")]
+    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    pub json: JsonArg,
+    #[command(flatten)]
+    pub read: ReadArgs,
+}
+
+/// The JSON summary of `identify`.
+#[derive(Debug, Serialize)]
+pub struct IdentifySummary {
+    /// Always "identify".
+    pub command: &'static str,
+    /// Order.
+    pub order: usize,
+    /// λ.
+    pub lambda: f64,
+    /// Parameter names.
+    pub names: Vec<String>,
+    /// Values, in `names` order.
+    pub values: Vec<f64>,
+    /// STD% per parameter.
+    pub std_pct: Vec<f64>,
+    /// The paper's verdict: reliable, unreliable or unusable.
+    pub reliability: pem::Reliability,
+    /// AIC.
+    pub aic: f64,
+    /// BIC.
+    pub bic: f64,
+    /// LM iterations.
+    pub iterations: usize,
+    /// One-step fit % per identification record.
+    pub fit_identification: Vec<f64>,
+    /// Mean fit % on the validation records per horizon (empty without --validate).
+    pub fit: BTreeMap<String, f64>,
+    /// Model files written.
+    pub model: Option<String>,
+}
+
+/// Runs `identify`.
+pub fn identify(args: &IdentifyArgs) -> Result<()> {
+    let recs = read_records(&args.read, &args.data, "--data")?;
+    let val = args.read.read_all(&args.validate)?;
+    let cfg = pem::PemConfig {
+        order: args.order,
+        lambda: args.lambda,
+        ..pem::PemConfig::default()
+    };
+    if let Some(o) = &args.orders {
+        let orders = parse_orders(o)?;
+        let lines = pem::select_order(&recs, &orders, &cfg).map_err(input_ident)?;
+        println!(
+            "{:>5} {:>6} {:>12} {:>12} {:>12} {:>8} {:>8} {:>8} {:>8} {:>10}",
+            "order",
+            "params",
+            "cost",
+            "AIC",
+            "BIC",
+            "fit@1",
+            "fit@5",
+            "fit@10",
+            "fit@sim",
+            "max STD%"
+        );
+        for l in &lines {
+            let f = |k: &str| l.fit.get(k).copied().unwrap_or(f64::NAN);
+            println!(
+                "{:>5} {:>6} {:>12.5e} {:>12.1} {:>12.1} {:>8.2} {:>8.2} {:>8.2} {:>8.2} {:>10.1}{}",
+                l.order,
+                l.params,
+                l.cost,
+                l.aic,
+                l.bic,
+                f("1"),
+                f("5"),
+                f("10"),
+                f("sim"),
+                l.max_std_pct,
+                l.error.as_deref().map(|e| format!("  failed: {e}")).unwrap_or_default()
+            );
+        }
+        if let Some(best) = lines
+            .iter()
+            .filter(|l| l.error.is_none() && l.bic.is_finite())
+            .min_by(|a, b| a.bic.total_cmp(&b.bic))
+        {
+            println!("lowest BIC: order {}", best.order);
+        }
+        return args.json.write(&serde_json::json!({
+            "command": "identify",
+            "orders": lines,
+        }));
+    }
+    let rep = pem::identify(&recs, None, &cfg).map_err(input_ident)?;
+    println!(
+        "identified order {} on {} record(s), {} samples: {} after {} iterations; paper's rule: {:?}",
+        rep.model.n,
+        recs.len(),
+        rep.samples,
+        rep.termination.describe(),
+        rep.iterations,
+        rep.reliability
+    );
+    print_params(&rep.names, &all_params(&rep.model), &rep.std_pct);
+    let fit = if val.is_empty() {
+        BTreeMap::new()
+    } else {
+        merge::validation_fits(&rep.model, &val)
+    };
+    if !fit.is_empty() {
+        let s: Vec<String> = yawcast::predict::Horizon::REPORT
+            .iter()
+            .filter_map(|h| fit.get(&h.key()).map(|v| format!("{}: {v:.2} %", h.key())))
+            .collect();
+        println!(
+            "validation fit (mean over {} records): {}",
+            val.len(),
+            s.join(", ")
+        );
+    }
+    let mut written = None;
+    if let Some(out) = &args.out {
+        let check = val.first().unwrap_or(&recs[0]);
+        let r = write_model(&rep.model, out, check)?;
+        println!(
+            "model written to {} and {}",
+            r.blob_path.display(),
+            r.json_path.display()
+        );
+        written = Some(r.blob_path.display().to_string());
+    }
+    args.json.write(&IdentifySummary {
+        command: "identify",
+        order: rep.model.n,
+        lambda: rep.lambda,
+        names: rep.names.clone(),
+        values: all_params(&rep.model),
+        std_pct: rep.std_pct.clone(),
+        reliability: rep.reliability,
+        aic: rep.aic,
+        bic: rep.bic,
+        iterations: rep.iterations,
+        fit_identification: rep.fit.clone(),
+        fit,
+        model: written,
+    })
+}
+
+/// Identification errors caused by the data are bad input; a search that found no stable
+/// model is a failure.
+fn input_ident(e: pem::IdentError) -> anyhow::Error {
+    let msg = e.to_string();
+    if msg.contains("start") && msg.contains("stable") {
+        anyhow::Error::new(e)
+    } else {
+        bad(msg)
+    }
+}
+
+/// Gene layout of the GA.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Genes {
+    /// R_a, R_b, R_k (and effect gains) and λ: the paper's groups.
+    Grouped,
+    /// One R_i per parameter, and λ.
+    PerParameter,
+}
+
+/// Arguments of `yawcast tune`.
+#[derive(Debug, Args)]
+pub struct TuneArgs {
+    /// Simulation records to identify from; repeatable.
+    #[arg(long, value_name = "FILE", required = true)]
+    pub data: Vec<PathBuf>,
+    /// Trial records the fitness is scored on; repeatable.
+    #[arg(long, value_name = "FILE", required = true)]
+    pub validate: Vec<PathBuf>,
+    /// Model order n.
+    #[arg(long, default_value_t = 4, value_name = "N")]
+    pub order: usize,
+    /// Gene layout.
+    #[arg(long, value_enum, default_value = "grouped")]
+    pub genes: Genes,
+    /// Decode genes on a log scale (the paper: linear).
+    #[arg(long)]
+    pub log_scale: bool,
+    /// One multi-record identification instead of averaging per-record models.
+    #[arg(long)]
+    pub joint: bool,
+    /// Generation cap.
+    #[arg(long, default_value_t = 50, value_name = "N")]
+    pub generations: usize,
+    /// Fitness horizons (mean k-step fit over them).
+    #[arg(long, default_value = "5,10", value_name = "LIST")]
+    pub horizons: String,
+    /// Where the tuned model goes (`<PATH>.postcard`, `.json`, and the paper's tables as
+    /// `<PATH>.tables.md`/`.tables.json`).
+    #[arg(long, value_name = "PATH")]
+    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    pub seed: SeedArg,
+    #[command(flatten)]
+    pub json: JsonArg,
+    #[command(flatten)]
+    pub read: ReadArgs,
+}
+
+/// Runs `tune`.
+pub fn tune(args: &TuneArgs) -> Result<()> {
+    let sim = read_records(&args.read, &args.data, "--data")?;
+    let trials = read_records(&args.read, &args.validate, "--validate")?;
+    let horizons: Vec<usize> = args
+        .horizons
+        .split(',')
+        .map(|h| {
+            h.trim()
+                .parse::<usize>()
+                .ok()
+                .filter(|k| *k >= 1)
+                .ok_or_else(|| bad(format!("--horizons: `{h}` is not a whole number ≥ 1")))
+        })
+        .collect::<Result<_>>()?;
+    let seed = args.seed.resolve();
+    let cfg = ga::GaConfig {
+        seed,
+        max_generations: args.generations,
+        horizons,
+        log_scale: args.log_scale,
+        grouped: args.genes == Genes::Grouped,
+        combine: if args.joint {
+            ga::Combine::Joint
+        } else {
+            ga::Combine::Average
+        },
+        pem: pem::PemConfig {
+            order: args.order,
+            ..ga::GaConfig::default().pem
+        },
+        ..ga::GaConfig::default()
+    };
+    let base_cfg = pem::PemConfig {
+        order: args.order,
+        ..pem::PemConfig::default()
+    };
+    let base = pem::identify(&sim[..1], None, &base_cfg)
+        .map_err(input_ident)
+        .context("the starting model")?
+        .model;
+    let rep = ga::tune(&sim, &trials, &base, &cfg).map_err(|e| match e {
+        ga::GaError::NoSimulation
+        | ga::GaError::NoTrials
+        | ga::GaError::Config(_)
+        | ga::GaError::Trial { .. } => bad(e),
+        other => anyhow::Error::new(other),
+    })?;
+    println!(
+        "GA: {} generations ({:?}), {} candidates, {} rejected; seed {}",
+        rep.generations, rep.termination, rep.evaluations, rep.rejected, rep.seed
+    );
+    println!("λ = {:.4}, best fitness {:.3} %", rep.lambda, rep.best_fit);
+    let tables = tables::Tables::from_ga(&rep, &trials).ok();
+    if let Some(t) = &tables {
+        println!("{}", t.to_markdown());
+    }
+    if let Some(out) = &args.out {
+        let r = write_model(&rep.best_model, out, &trials[0])?;
+        println!(
+            "tuned model written to {} and {}",
+            r.blob_path.display(),
+            r.json_path.display()
+        );
+        if let Some(t) = &tables {
+            let (md, js) = t.write(out)?;
+            println!("tables written to {} and {}", md.display(), js.display());
+        }
+    }
+    args.json.write(&serde_json::json!({
+        "command": "tune",
+        "seed": rep.seed,
+        "lambda": rep.lambda,
+        "r": rep.r,
+        "best_fit": rep.best_fit,
+        "generations": rep.generations,
+        "termination": rep.termination,
+        "tuned": { "fit": rep.tuned.fits, "std_pct": rep.tuned.std_pct },
+        "conventional": rep.conventional.as_ref().map(|c| serde_json::json!({ "fit": c.fits, "std_pct": c.std_pct })),
+        "history": rep.history,
+    }))
+}
+
+/// Which combination `average` writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Method {
+    /// The one that validates best.
+    Best,
+    /// Plain parameter average (the paper).
+    Average,
+    /// Covariance-weighted merge with a χ² consistency test.
+    Merge,
+    /// One multi-record identification.
+    Multi,
+}
+
+/// Arguments of `yawcast average`.
+#[derive(Debug, Args)]
+pub struct AverageArgs {
+    /// Records, one model each (and all together for `multi`); repeatable.
+    #[arg(long, value_name = "FILE", required = true)]
+    pub data: Vec<PathBuf>,
+    /// Validation records the combinations are compared on; repeatable.
+    #[arg(long, value_name = "FILE", required = true)]
+    pub validate: Vec<PathBuf>,
+    /// Model order n.
+    #[arg(long, default_value_t = 4, value_name = "N")]
+    pub order: usize,
+    /// Which combination to write.
+    #[arg(long, value_enum, default_value = "best")]
+    pub method: Method,
+    /// Where the chosen model goes (`<PATH>.postcard` and `.json`).
+    #[arg(long, value_name = "PATH")]
+    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    pub json: JsonArg,
+    #[command(flatten)]
+    pub read: ReadArgs,
+}
+
+/// Runs `average`.
+pub fn average(args: &AverageArgs) -> Result<()> {
+    let recs = read_records(&args.read, &args.data, "--data")?;
+    let val = read_records(&args.read, &args.validate, "--validate")?;
+    let cfg = pem::PemConfig {
+        order: args.order,
+        ..pem::PemConfig::default()
+    };
+    let rep = merge::compare(&recs, &val, None, &cfg).map_err(|e| match e {
+        merge::MergeError::Identification { .. } | merge::MergeError::NoValidation => bad(e),
+        other => anyhow::Error::new(other),
+    })?;
+    println!(
+        "{:<8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>7}  note",
+        "method", "fit@1", "fit@5", "fit@10", "fit@20", "fit@sim", "stable"
+    );
+    for c in &rep.combinations {
+        let f = |k: &str| c.fits.get(k).copied().unwrap_or(f64::NAN);
+        println!(
+            "{:<8} {:>8.2} {:>8.2} {:>8.2} {:>8.2} {:>8.2} {:>7}  {}",
+            c.name,
+            f("1"),
+            f("5"),
+            f("10"),
+            f("20"),
+            f("sim"),
+            c.stable,
+            c.note
+        );
+    }
+    if let Some(e) = &rep.merge_error {
+        println!("merge not available: {e}");
+    }
+    let want = match args.method {
+        Method::Best => rep.best.clone(),
+        Method::Average => Some("average".into()),
+        Method::Merge => Some("merge".into()),
+        Method::Multi => Some("multi".into()),
+    };
+    let chosen = want
+        .as_deref()
+        .and_then(|w| rep.combinations.iter().find(|c| c.name == w));
+    if let Some(c) = chosen {
+        println!("chosen: {}", c.name);
+    }
+    if let Some(out) = &args.out {
+        let c = chosen.ok_or_else(|| {
+            anyhow::anyhow!(
+                "the {:?} combination is not available (no stable combination, or merge failed)",
+                args.method
+            )
+        })?;
+        let r = write_model(&c.model, out, &val[0])?;
+        println!(
+            "model written to {} and {}",
+            r.blob_path.display(),
+            r.json_path.display()
+        );
+    }
+    args.json.write(&serde_json::json!({
+        "command": "average",
+        "best": rep.best,
+        "chosen": chosen.map(|c| c.name.clone()),
+        "combinations": rep.combinations.iter().map(|c| serde_json::json!({
+            "name": c.name, "fit": c.fits, "stable": c.stable, "note": c.note,
+        })).collect::<Vec<_>>(),
+        "merge_error": rep.merge_error,
+    }))
+}
+
+/// Arguments of `yawcast export`.
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    /// The model (a `.json` twin or a `.postcard` blob).
+    #[arg(long, value_name = "FILE")]
+    pub model: PathBuf,
+    /// The record the firmware check runs on (host f64 vs firmware f32 fit within 0.01 pp).
+    #[arg(long, value_name = "FILE")]
+    pub data: PathBuf,
+    /// Where the blob goes: `<PATH>.postcard` and its `<PATH>.json` twin.
+    #[arg(long, value_name = "PATH")]
+    pub out: PathBuf,
+    /// Also write golden vectors (20-step predictions) for the firmware tests to this file.
+    #[arg(long, value_name = "FILE")]
+    pub golden: Option<PathBuf>,
+    #[command(flatten)]
+    pub json: JsonArg,
+    #[command(flatten)]
+    pub read: ReadArgs,
+}
+
+/// Runs `export`.
+pub fn export_cmd(args: &ExportArgs) -> Result<()> {
+    let model = read_model(&args.model)?;
+    let check = args.read.read(&args.data)?;
+    super::common::check_record_for_model(&check, &model, &args.data)?;
+    let cfg = export::ExportConfig {
+        golden: args.golden.clone(),
+        ..export::ExportConfig::default()
+    };
+    let r = export::export_with(&model, &args.out, &check, &cfg).map_err(|e| match e {
+        export::ExportError::Check { .. } | export::ExportError::Model(_) => bad(e),
+        other => anyhow::Error::new(other),
+    })?;
+    println!(
+        "{:>8} {:>12} {:>14} {:>10}",
+        "horizon", "host f64", "firmware f32", "Δ [pp]"
+    );
+    for c in &r.checks {
+        println!(
+            "{:>8} {:>12.4} {:>14.4} {:>10.5}",
+            c.horizon,
+            c.host_fit,
+            c.firmware_fit,
+            (c.host_fit - c.firmware_fit).abs()
+        );
+    }
+    println!(
+        "exported {} ({} bytes) and {}{}",
+        r.blob_path.display(),
+        r.blob_len,
+        r.json_path.display(),
+        r.golden_path
+            .as_ref()
+            .map(|g| format!("; golden vectors {}", g.display()))
+            .unwrap_or_default()
+    );
+    args.json.write(&r)
+}
