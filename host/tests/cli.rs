@@ -579,7 +579,18 @@ fn identify_average_export_compare_chain() {
     ]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
 
-    // Bad input: an order range outside 2..=8, a constant input.
+    // Bad input: --json on the model's own twin, an order range outside 2..=8, a constant input.
+    let o = run(&[
+        "identify",
+        "--data",
+        &p("s0.csv"),
+        "--out",
+        &p("m2"),
+        "--json",
+        &p("m2.json"),
+    ]);
+    assert_eq!(code(&o), 2);
+    assert!(stderr(&o).contains("JSON twin"), "{}", stderr(&o));
     let o = run(&["identify", "--data", &p("s0.csv"), "--orders", "1..9"]);
     assert_eq!(code(&o), 2);
     assert!(stderr(&o).contains("--orders"), "{}", stderr(&o));

@@ -29,6 +29,20 @@ fn write_model(model: &Model, out: &Path, check: &Record) -> Result<export::Expo
         .with_context(|| format!("writing the model {}", out.display()))
 }
 
+/// Refuses a `--json` path that is the model's own JSON twin (`--out` would be overwritten).
+fn check_json_vs_out(out: Option<&Path>, json: &JsonArg) -> Result<()> {
+    if let (Some(out), Some(j)) = (out, &json.json) {
+        let (_, twin) = export::paths(out);
+        if &twin == j {
+            return Err(bad(format!(
+                "--json {} is the JSON twin of the model written by --out; choose another name",
+                j.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
 fn print_params(names: &[String], theta: &[f64], std_pct: &[f64]) {
     println!("{:<22} {:>14} {:>9}", "parameter", "value", "STD %");
     for (i, n) in names.iter().enumerate() {
@@ -136,6 +150,7 @@ pub struct IdentifySummary {
 
 /// Runs `identify`.
 pub fn identify(args: &IdentifyArgs) -> Result<()> {
+    check_json_vs_out(args.out.as_deref(), &args.json)?;
     let recs = read_records(&args.read, &args.data, "--data")?;
     let val = args.read.read_all(&args.validate)?;
     let cfg = pem::PemConfig {
@@ -304,6 +319,7 @@ pub struct TuneArgs {
 
 /// Runs `tune`.
 pub fn tune(args: &TuneArgs) -> Result<()> {
+    check_json_vs_out(args.out.as_deref(), &args.json)?;
     let sim = read_records(&args.read, &args.data, "--data")?;
     let trials = read_records(&args.read, &args.validate, "--validate")?;
     let horizons: Vec<usize> = args
@@ -424,6 +440,7 @@ pub struct AverageArgs {
 
 /// Runs `average`.
 pub fn average(args: &AverageArgs) -> Result<()> {
+    check_json_vs_out(args.out.as_deref(), &args.json)?;
     let recs = read_records(&args.read, &args.data, "--data")?;
     let val = read_records(&args.read, &args.validate, "--validate")?;
     let cfg = pem::PemConfig {
@@ -515,6 +532,7 @@ pub struct ExportArgs {
 
 /// Runs `export`.
 pub fn export_cmd(args: &ExportArgs) -> Result<()> {
+    check_json_vs_out(Some(&args.out), &args.json)?;
     let model = read_model(&args.model)?;
     let check = args.read.read(&args.data)?;
     super::common::check_record_for_model(&check, &model, &args.data)?;
