@@ -2,6 +2,7 @@
 //! diagnosis and export. f64 throughout; firmware-exact numbers come from `yawcast-firmware`.
 #![deny(missing_docs)]
 
+pub mod compare;
 pub mod data;
 pub mod demo;
 pub mod export;
@@ -13,4 +14,5 @@ pub mod nmea;
 pub mod pem;
 pub mod predict;
 pub mod report;
+pub mod resid;
 pub mod tables;
