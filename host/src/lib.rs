@@ -2,9 +2,11 @@
 //! diagnosis and export. f64 throughout; firmware-exact numbers come from `yawcast-firmware`.
 #![deny(missing_docs)]
 
+pub mod augment;
 pub mod compare;
 pub mod data;
 pub mod demo;
+pub mod diagnose;
 pub mod export;
 pub mod ga;
 pub mod hil;
@@ -15,4 +17,5 @@ pub mod pem;
 pub mod predict;
 pub mod report;
 pub mod resid;
+pub mod sim;
 pub mod tables;

@@ -276,7 +276,7 @@ fn psi0(rec: &Record) -> f64 {
 /// let m = Model::new(1.0, vec![0.0, 0.5], vec![1.0, 0.5], vec![0.0, 0.0]).unwrap();
 /// let r = Record::from_uy("x", 1.0, vec![1.0; 4], vec![0.0; 4]);
 /// // K = 0: pure simulation; x1(1) = b1·u = 1.
-/// assert_eq!(predict::one_step(&m, &r, &[0.0, 0.0]), vec![0.0, 1.0, 1.5, 1.5]);
+/// assert_eq!(predict::one_step(&m, &r, &[0.0, 0.0]), vec![0.0, 1.0, 1.5, 1.75]);
 /// ```
 pub fn one_step(model: &Model, rec: &Record, x0: &[f64]) -> Vec<f64> {
     let s = Stepper::new(model);

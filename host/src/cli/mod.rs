@@ -3,10 +3,14 @@
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 
+pub mod augment;
 pub mod common;
 pub mod compare;
+pub mod demo;
+pub mod diagnose;
 pub mod hil;
 pub mod pipeline;
+pub mod simulate;
 
 /// yawcast — ship trials to a yaw-rate predictor that runs on the ship's controller.
 ///
@@ -25,7 +29,7 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Simulate records of the built-in (or your) ship: identification inputs, trials, manoeuvres.
-    Simulate(Pending),
+    Simulate(simulate::SimulateArgs),
     /// Identify a model from records (prediction-error method), or select the order.
     Identify(pipeline::IdentifyArgs),
     /// Tune the regularisation (λ, R) with the genetic algorithm, scored on trial records.
@@ -37,38 +41,13 @@ pub enum Command {
     /// Fit % of a model on records per horizon; measured vs predicted series.
     Compare(compare::CompareArgs),
     /// Which physical effect is missing from the model? Evidence for every effect, and a verdict.
-    Diagnose(Pending),
+    Diagnose(diagnose::DiagnoseArgs),
     /// Add an effect to a model, re-identify, and show the error before and after.
-    Augment(Pending),
+    Augment(augment::AugmentArgs),
     /// The whole story on the built-in ship with a hidden effect, ending in report.html.
-    Demo(Pending),
+    Demo(demo::DemoArgs),
     /// Hardware in the loop: the simulator sails, the firmware (QEMU or a board) predicts.
     Hil(hil::HilArgs),
-}
-
-/// Arguments of a tool not wired into this build yet.
-#[derive(Debug, clap::Args)]
-pub struct Pending {
-    /// Arguments.
-    #[arg(trailing_var_arg = true, allow_hyphen_values = true, hide = true)]
-    pub rest: Vec<String>,
-}
-
-impl Command {
-    fn name(&self) -> &'static str {
-        match self {
-            Command::Simulate(_) => "simulate",
-            Command::Identify(_) => "identify",
-            Command::Tune(_) => "tune",
-            Command::Average(_) => "average",
-            Command::Export(_) => "export",
-            Command::Compare(_) => "compare",
-            Command::Diagnose(_) => "diagnose",
-            Command::Augment(_) => "augment",
-            Command::Demo(_) => "demo",
-            Command::Hil(_) => "hil",
-        }
-    }
 }
 
 /// Runs the parsed command line.
@@ -80,7 +59,10 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Tune(a) => pipeline::tune(a),
         Command::Average(a) => pipeline::average(a),
         Command::Export(a) => pipeline::export_cmd(a),
-        other => anyhow::bail!("`yawcast {}` is not available in this build", other.name()),
+        Command::Simulate(a) => simulate::run(a),
+        Command::Diagnose(a) => diagnose::run(a),
+        Command::Augment(a) => augment::run(a),
+        Command::Demo(a) => demo::run(a),
     }
 }
 

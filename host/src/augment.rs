@@ -1,0 +1,1 @@
+//! Placeholder for the `augment` module (being written).

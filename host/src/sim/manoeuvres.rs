@@ -1,0 +1,176 @@
+//! Standard manoeuvres for sanity checks: turning circle and zig-zag (IMO MSC.137(76) style),
+//! run on the ship with its own effects and no noise.
+
+use super::inputs::ZigZagLogic;
+use super::{run, RunSpec, Ship, SimError};
+
+/// Sample time of the manoeuvre runs (s).
+const TS: f64 = 0.1;
+/// Longest manoeuvre (s).
+const T_MAX: f64 = 7200.0;
+
+/// Turning-circle figures.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TurningResult {
+    /// Advance: distance along the approach course when the heading has changed by 90° (m).
+    pub advance_m: f64,
+    /// Transfer: distance across the approach course at 90° heading change (m).
+    pub transfer_m: f64,
+    /// Tactical diameter: distance across the approach course at 180° heading change (m).
+    pub tactical_diameter_m: f64,
+    /// Steady yaw rate, averaged over the heading change 360°–450° (deg/s, signed as δ).
+    pub steady_r_degps: f64,
+    /// Steady speed over ground over the same stretch (m/s).
+    pub steady_speed_mps: f64,
+}
+
+/// Zig-zag figures.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ZigzagResult {
+    /// Heading overshoot beyond the switch angle after the first switch (deg).
+    pub first_overshoot_deg: f64,
+    /// Heading overshoot after the second switch (deg).
+    pub second_overshoot_deg: f64,
+    /// Time from the start to the first switch (s).
+    pub time_to_switch_s: f64,
+}
+
+fn settled(ship: &Ship) -> RunSpec<'_> {
+    RunSpec {
+        ship,
+        effects: ship.effects(),
+        ts: TS,
+        n: (T_MAX / TS) as usize,
+        dt_max: 0.05,
+        warmup_s: 60.0,
+        psi0_deg: 0.0,
+    }
+}
+
+/// Turning circle from a steady straight approach (at the ship's own speed) with a constant
+/// command `delta_deg` from `t = 0`.
+///
+/// # Errors
+/// [`SimError::Invalid`] for a bad ship or a non-finite or zero `delta_deg`;
+/// [`SimError::Manoeuvre`] when the heading does not change by 450° within two hours.
+///
+/// ```
+/// use yawcast::sim::{turning_circle, Ship};
+/// let ship = Ship::default_lng();
+/// let tc = turning_circle(&ship, 35.0).unwrap();
+/// let l = ship.main.lpp_m;
+/// assert!(tc.tactical_diameter_m > 2.0 * l && tc.tactical_diameter_m < 6.0 * l);
+/// ```
+pub fn turning_circle(ship: &Ship, delta_deg: f64) -> Result<TurningResult, SimError> {
+    ship.validate()?;
+    if !delta_deg.is_finite() || delta_deg == 0.0 {
+        return Err(SimError::invalid("delta_deg", delta_deg, "finite and non-zero"));
+    }
+    let sg = delta_deg.signum();
+    let spec = settled(ship);
+    let mut prev: Option<(f64, f64, f64)> = None; // (Δψ deg, x, y)
+    let mut at90 = None;
+    let mut at180 = None;
+    let (mut r_sum, mut sp_sum, mut cnt) = (0.0, 0.0, 0usize);
+    let mut done = false;
+    run(
+        &spec,
+        |_, _| delta_deg,
+        |smp| {
+            let s = smp.state;
+            let dpsi = sg * s[5].to_degrees();
+            let (x, y) = (s[3], sg * s[4]);
+            if let Some((p, px, py)) = prev {
+                for (target, slot) in [(90.0, &mut at90), (180.0, &mut at180)] {
+                    if slot.is_none() && p < target && dpsi >= target {
+                        let w = (target - p) / (dpsi - p);
+                        *slot = Some((px + w * (x - px), py + w * (y - py)));
+                    }
+                }
+            }
+            prev = Some((dpsi, x, y));
+            if (360.0..450.0).contains(&dpsi) {
+                r_sum += s[2].to_degrees();
+                sp_sum += s[0].hypot(s[1]);
+                cnt += 1;
+            }
+            done = dpsi >= 450.0;
+            !done
+        },
+    )?;
+    match (at90, at180, done && cnt > 0) {
+        (Some((adv, tr)), Some((_, td)), true) => Ok(TurningResult {
+            advance_m: adv,
+            transfer_m: tr,
+            tactical_diameter_m: td,
+            steady_r_degps: r_sum / cnt as f64,
+            steady_speed_mps: sp_sum / cnt as f64,
+        }),
+        _ => Err(SimError::Manoeuvre {
+            manoeuvre: "turning circle",
+            reason: format!("heading did not change by 450° within {T_MAX} s at δ = {delta_deg}°"),
+        }),
+    }
+}
+
+/// Zig-zag `delta_deg`/`psi_deg` (10/10, 20/20, …) from a steady straight approach,
+/// starting to starboard.
+///
+/// # Errors
+/// [`SimError::Invalid`] for a bad ship or non-positive angles; [`SimError::Manoeuvre`]
+/// when the third switch does not come within two hours.
+///
+/// ```
+/// use yawcast::sim::{zigzag, Ship};
+/// let z = zigzag(&Ship::default_lng(), 10.0, 10.0).unwrap();
+/// assert!(z.first_overshoot_deg > 2.0 && z.first_overshoot_deg < 20.0);
+/// ```
+pub fn zigzag(ship: &Ship, delta_deg: f64, psi_deg: f64) -> Result<ZigzagResult, SimError> {
+    ship.validate()?;
+    super::ship::within("delta_deg", delta_deg, 1e-3, 90.0)?;
+    super::ship::within("psi_deg", psi_deg, 1e-3, 180.0)?;
+    let spec = settled(ship);
+    let mut logic = ZigZagLogic::new(delta_deg, psi_deg);
+    let (mut max1, mut min2) = (f64::NEG_INFINITY, f64::INFINITY);
+    let mut t_switch = f64::NAN;
+    let mut switches = 0;
+    run(
+        &spec,
+        |_, s| logic.command(s[5].to_degrees()),
+        |smp| {
+            let dpsi = smp.state[5].to_degrees();
+            // the logic switches in `command`, called right after this observation
+            match switches {
+                1 => max1 = max1.max(dpsi),
+                2 => min2 = min2.min(dpsi),
+                _ => {}
+            }
+            let will_switch = match switches % 2 {
+                0 => dpsi >= psi_deg,
+                _ => dpsi <= -psi_deg,
+            };
+            if will_switch && smp.k > 0 {
+                switches += 1;
+                if switches == 1 {
+                    t_switch = smp.k as f64 * TS;
+                    max1 = dpsi;
+                }
+                if switches == 2 {
+                    min2 = dpsi;
+                }
+            }
+            switches < 3
+        },
+    )?;
+    if switches < 3 {
+        return Err(SimError::Manoeuvre {
+            manoeuvre: "zig-zag",
+            reason: format!("only {switches} of 3 switches within {T_MAX} s"),
+        });
+    }
+    Ok(ZigzagResult {
+        first_overshoot_deg: max1 - psi_deg,
+        second_overshoot_deg: -min2 - psi_deg,
+        time_to_switch_s: t_switch,
+    })
+}
