@@ -1,1 +1,967 @@
-//! Placeholder for the `augment` module (being written).
+//! Augment a model with one library effect: add it, re-identify, and keep it only when it
+//! improves prediction on held-out records.
+//!
+//! # Method
+//!
+//! 1. **Baseline.** The input structure (with whatever effects it already carries) is
+//!    re-identified on the estimation records, so the comparison with the candidate is fair:
+//!    both have seen the same data.
+//! 2. **Candidate.** The effect is appended (stacked on the model's effects).
+//!    - *Linear-gain effects* (bias, gyro bias, asymmetry, nonlinear damping, wind, current):
+//!      PEM ([`pem::identify`]) from the ARX and ARMAX starts and from the input model with
+//!      the new gain at zero; the lowest estimation cost wins.
+//!    - *Actuator effects* (dead time d, slew limit ρ, angle limit δ_max): a grid of the
+//!      structural parameter (d = 1..=[`MAX_DEAD_TIME`] samples; ρ on a log grid over
+//!      0.5–20 °/s, which covers real steering gears' 2.3–9 °/s; δ_max over the quantiles
+//!      of the recorded |δ|). Every grid value is scored cheaply with θ frozen (one-step cost
+//!      of the input and of the baseline model with the effect added); the best few are
+//!      re-identified, and a continuous parameter is refined by golden-section search between
+//!      the neighbours of the best, each point re-identified from a warm start.
+//! 3. **Held-out judgement.** Fit % per horizon on the validation records of the input model
+//!    (`before`), the baseline and the candidate (`after`). When no validation record is
+//!    given, the last third of each estimation record is held out (or, for short records,
+//!    the last third of the records); the candidate kept is then re-identified on the whole
+//!    records from its held-out-tested parameters.
+//! 4. **Decision.** The effect is kept when the candidate is stable, predicts finitely and
+//!    survives the f32 export round trip, its ΔBIC against the baseline is negative (an
+//!    actuator parameter counts as one parameter), its paired held-out fit gain over the
+//!    baseline at 10 steps or in simulation is significant against the spread of the gain
+//!    over records (one-sided Student t at 95 %; records are cut into blocks when there are
+//!    fewer than four), neither horizon is significantly worse, and it does not validate
+//!    worse than the input model at 10 steps or in simulation. Otherwise the input model is
+//!    returned unchanged, with the reason.
+
+use std::collections::BTreeMap;
+
+use rayon::prelude::*;
+use serde::{Serialize, Serializer};
+use thiserror::Error;
+use yawcast_shared::model::EffectKind;
+
+use crate::compare::{check_inputs, InputError};
+use crate::data::Record;
+use crate::model::{Effect, Model};
+use crate::pem::{self, IdentError, PemConfig, PemReport};
+use crate::predict::{self, Horizon};
+use crate::resid;
+use crate::sim::{self, Scenario, Ship, SimEffect};
+
+/// Largest dead time tried (samples): the firmware's delay-line length.
+pub const MAX_DEAD_TIME: usize = yawcast_shared::model::MAX_DEAD_TIME as usize;
+
+/// Slew-limit grid bounds (deg/s).
+const RATE_GRID: (f64, f64, usize) = (0.5, 20.0, 25);
+
+/// Grid values re-identified after the frozen-θ scoring (per frozen model).
+const TOP_FROZEN: usize = 3;
+
+/// Golden-section evaluations when refining a continuous actuator parameter.
+const REFINE_STEPS: usize = 8;
+
+/// Settings of [`augment`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct AugmentConfig {
+    /// PEM settings for the re-identifications (`order` is taken from the model; `r` and
+    /// `nominal`, when given for the input structure, get zero weights for the new gains).
+    pub pem: PemConfig,
+    /// Horizons reported (default 1, 5, 10, 20 and sim; 10 and sim are always evaluated,
+    /// they carry the decision).
+    pub horizons: Vec<Horizon>,
+    /// Evaluate grid points and records in parallel (rayon).
+    pub parallel: bool,
+}
+
+impl Default for AugmentConfig {
+    fn default() -> Self {
+        AugmentConfig {
+            pem: PemConfig::default(),
+            horizons: Horizon::REPORT.to_vec(),
+            parallel: true,
+        }
+    }
+}
+
+/// Why a model cannot be augmented.
+#[derive(Debug, Error, PartialEq)]
+#[non_exhaustive]
+pub enum AugmentError {
+    /// The model or the records are unusable (sample time, lengths, non-finite data, …).
+    #[error(transparent)]
+    Input(#[from] InputError),
+    /// Re-identification failed for the baseline (the input structure itself).
+    #[error("re-identifying the model failed: {0}")]
+    Ident(#[from] IdentError),
+    /// The model already carries this effect.
+    #[error(
+        "the model already carries the effect `{}`; effects stack, but each kind only once",
+        .0.name()
+    )]
+    AlreadyPresent(EffectKind),
+}
+
+fn ser_kind<S: Serializer>(k: &EffectKind, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(k.name())
+}
+
+/// What [`augment`] found.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AugmentReport {
+    /// The effect tried (serialised as its name, e.g. `"rate-limit"`).
+    #[serde(serialize_with = "ser_kind")]
+    pub effect: EffectKind,
+    /// The model with the effect added and re-identified.
+    pub candidate: Model,
+    /// `candidate` when kept, else the input model unchanged.
+    pub model: Model,
+    /// Whether the effect was kept.
+    pub kept: bool,
+    /// Held-out fit % of the input model, keyed by horizon (`"1"`, `"5"`, `"10"`, `"20"`, `"sim"`).
+    pub before: BTreeMap<String, f64>,
+    /// Held-out fit % of the input structure re-identified on the estimation records.
+    pub baseline: BTreeMap<String, f64>,
+    /// Held-out fit % of the candidate.
+    pub after: BTreeMap<String, f64>,
+    /// `after − baseline` at 10 steps (pp): the gain the decision judges.
+    pub fit_gain_pp: f64,
+    /// AIC of the candidate minus the baseline's, on the estimation records.
+    pub delta_aic: f64,
+    /// BIC of the candidate minus the baseline's, on the estimation records.
+    pub delta_bic: f64,
+    /// Ljung–Box p-value (25 lags) of the input model's held-out one-step residuals.
+    pub ljung_box_p_before: f64,
+    /// The same for the candidate.
+    pub ljung_box_p_after: f64,
+    /// STD% of the candidate's estimated parameters (θ then effect gains).
+    pub std_pct: Vec<f64>,
+    /// Physical words with numbers: the effect's size, the fits, the decision and why.
+    pub explanation: String,
+}
+
+/// Held-out evaluation of one model.
+struct Eval {
+    mean: BTreeMap<String, f64>,
+    units10: Vec<f64>,
+    units_sim: Vec<f64>,
+    resid: Vec<Vec<f64>>,
+    finite: bool,
+}
+
+/// Splits the estimation records into estimation and held-out parts.
+fn holdout(est: &[Record], n: usize) -> Result<(Vec<Record>, Vec<Record>, String), InputError> {
+    let min_part = (12 * n + 12).max(100);
+    if est.iter().all(|r| r.len() / 3 >= min_part) {
+        let mut e = Vec::new();
+        let mut v = Vec::new();
+        for r in est {
+            let cut = r.len() - r.len() / 3;
+            let mut a = r.slice(0, cut);
+            let mut b = r.slice(cut, r.len());
+            a.name = format!("{} (first two thirds)", r.name);
+            b.name = format!("{} (last third)", r.name);
+            e.push(a);
+            v.push(b);
+        }
+        return Ok((
+            e,
+            v,
+            "no validation records given: the last third of each estimation record was held out"
+                .into(),
+        ));
+    }
+    if est.len() >= 3 {
+        let k = est.len().div_ceil(3);
+        let split = est.len() - k;
+        return Ok((
+            est[..split].to_vec(),
+            est[split..].to_vec(),
+            format!(
+                "no validation records given: the last {k} of {} estimation records were held out",
+                est.len()
+            ),
+        ));
+    }
+    let short = est
+        .iter()
+        .min_by_key(|r| r.len())
+        .map(|r| (r.name.clone(), r.len()))
+        .unwrap_or_default();
+    Err(InputError::TooShort {
+        record: short.0,
+        found: short.1,
+        needed: 3 * min_part,
+        why: "holding out its last third for validation (no validation records given; \
+              give --validate records or at least three estimation records)"
+            .into(),
+    })
+}
+
+/// Number of blocks each held-out record is cut into for the spread of the gain.
+fn blocks_per_record(records: usize) -> usize {
+    if records >= 4 {
+        1
+    } else {
+        6usize.div_ceil(records.max(1))
+    }
+}
+
+fn evaluate(model: &Model, val: &[Record], horizons: &[Horizon], parallel: bool) -> Eval {
+    let nb = blocks_per_record(val.len());
+    let one = |rec: &Record| {
+        let x0 = predict::estimate_x0(model, rec);
+        let mut fits = BTreeMap::new();
+        let mut u10 = Vec::new();
+        let mut usim = Vec::new();
+        let mut res = Vec::new();
+        for h in horizons {
+            let yhat = predict::predict(model, rec, &x0, *h);
+            fits.insert(h.key(), predict::fit(&rec.y, &yhat));
+            let len = rec.len();
+            let blocks: Vec<f64> = (0..nb)
+                .map(|b| {
+                    let (s, e) = (b * len / nb, (b + 1) * len / nb);
+                    predict::fit(&rec.y[s..e], &yhat[s..e])
+                })
+                .collect();
+            match h {
+                Horizon::Steps(10) => u10 = blocks,
+                Horizon::Sim => usim = blocks,
+                Horizon::Steps(1) => {
+                    res = rec.y.iter().zip(&yhat).map(|(a, b)| a - b).collect();
+                }
+                _ => {}
+            }
+        }
+        (fits, u10, usim, res)
+    };
+    let per: Vec<_> = if parallel {
+        val.par_iter().map(one).collect()
+    } else {
+        val.iter().map(one).collect()
+    };
+    let keys: Vec<String> = horizons.iter().map(Horizon::key).collect();
+    let mean = crate::compare::mean_fits(per.iter().map(|p| &p.0), &keys);
+    let finite = mean.values().all(|v| v.is_finite());
+    let mut e = Eval {
+        mean,
+        units10: Vec::new(),
+        units_sim: Vec::new(),
+        resid: Vec::new(),
+        finite,
+    };
+    for (_, a, b, r) in per {
+        e.units10.extend(a);
+        e.units_sim.extend(b);
+        e.resid.push(r);
+    }
+    e
+}
+
+/// One-sided 95 % Student t quantile for `dof` degrees of freedom.
+fn t_crit(dof: usize) -> f64 {
+    const T: [f64; 30] = [
+        6.314, 2.920, 2.353, 2.132, 2.015, 1.943, 1.895, 1.860, 1.833, 1.812, 1.796, 1.782, 1.771,
+        1.761, 1.753, 1.746, 1.740, 1.734, 1.729, 1.725, 1.721, 1.717, 1.714, 1.711, 1.708, 1.706,
+        1.703, 1.701, 1.699, 1.697,
+    ];
+    match dof {
+        0 => f64::INFINITY,
+        d if d <= 30 => T[d - 1],
+        _ => 1.645,
+    }
+}
+
+/// Paired gain statistics: (mean, standard error, t).
+fn paired(after: &[f64], base: &[f64]) -> (f64, f64, f64) {
+    let g: Vec<f64> = after.iter().zip(base).map(|(a, b)| a - b).collect();
+    let k = g.len();
+    if k == 0 || g.iter().any(|v| !v.is_finite()) {
+        return (f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+    }
+    let m = g.iter().sum::<f64>() / k as f64;
+    if k < 2 {
+        return (m, f64::INFINITY, 0.0);
+    }
+    let var = g.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (k - 1) as f64;
+    let se = (var / k as f64).sqrt();
+    let t = if se > 0.0 {
+        m / se
+    } else if m > 0.0 {
+        f64::INFINITY
+    } else if m < 0.0 {
+        f64::NEG_INFINITY
+    } else {
+        0.0
+    };
+    (m, se, t)
+}
+
+fn ljung_box_p(resid: &[Vec<f64>]) -> f64 {
+    let n: usize = resid.iter().map(Vec::len).sum();
+    if resid.iter().flatten().any(|v| !v.is_finite()) || n < 30 {
+        return f64::NAN;
+    }
+    let acf = resid::acf(resid, 25);
+    resid::ljung_box(&acf, n, 25).1
+}
+
+/// PEM settings for a structure with `p` estimated parameters.
+fn pem_cfg(cfg: &AugmentConfig, n: usize, p: usize) -> PemConfig {
+    let fit_len = |v: &Option<Vec<f64>>| {
+        v.as_ref().map(|v| {
+            let mut v = v.clone();
+            v.resize(p, 0.0);
+            v
+        })
+    };
+    PemConfig {
+        order: n,
+        r: fit_len(&cfg.pem.r),
+        nominal: fit_len(&cfg.pem.nominal),
+        parallel: cfg.parallel && cfg.pem.parallel,
+        ..cfg.pem.clone()
+    }
+}
+
+fn n_params(m: &Model) -> usize {
+    3 * m.n + m.effect_gains().len()
+}
+
+/// Identifies `template`'s structure on `est`: ARX, ARMAX and the template itself as
+/// starts (the template only when it is stable), lowest cost wins.
+fn reidentify(
+    est: &[Record],
+    template: &Model,
+    cfg: &AugmentConfig,
+) -> Result<PemReport, IdentError> {
+    let pc = pem_cfg(cfg, template.n, n_params(template));
+    let fresh = pem::identify(est, Some(template), &pc);
+    if template.is_stable() {
+        if let Ok(warm) = pem::identify_from(est, template, &pc) {
+            if fresh.as_ref().map_or(true, |f| warm.cost < f.cost) {
+                return Ok(warm);
+            }
+        }
+    }
+    fresh
+}
+
+/// A warm-started re-identification from `start` (falls back to a fresh one).
+fn reidentify_warm(
+    est: &[Record],
+    start: &Model,
+    cfg: &AugmentConfig,
+) -> Result<PemReport, IdentError> {
+    let pc = pem_cfg(cfg, start.n, n_params(start));
+    if start.is_stable() {
+        if let Ok(r) = pem::identify_from(est, start, &pc) {
+            return Ok(r);
+        }
+    }
+    pem::identify(est, Some(start), &pc)
+}
+
+/// One-step cost (mean squared error, x̂(0) estimated per record) of a fixed model.
+fn frozen_cost(model: &Model, est: &[Record]) -> f64 {
+    let mut sse = 0.0;
+    let mut n = 0usize;
+    for r in est {
+        let x0 = predict::estimate_x0(model, r);
+        let yhat = predict::one_step(model, r, &x0);
+        sse +=
+            r.y.iter()
+                .zip(&yhat)
+                .map(|(a, b)| (a - b).powi(2))
+                .sum::<f64>();
+        n += r.len();
+    }
+    if sse.is_finite() {
+        sse / n.max(1) as f64
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The structural-parameter grid of an actuator effect.
+fn actuator_grid(kind: EffectKind, est: &[Record], ts: f64) -> Vec<f64> {
+    match kind {
+        EffectKind::DeadTime => {
+            let shortest = est.iter().map(Record::len).min().unwrap_or(0);
+            let max = MAX_DEAD_TIME.min(shortest / 10).max(1);
+            (1..=max).map(|d| d as f64).collect()
+        }
+        EffectKind::RateLimit => {
+            // ρ·Ts at or above the largest command step is no limit at all
+            let max_step = est
+                .iter()
+                .flat_map(|r| r.u.windows(2).map(|w| (w[1] - w[0]).abs()))
+                .fold(0.0, f64::max);
+            let (lo, hi, k) = RATE_GRID;
+            let hi = hi.min(max_step / ts).max(lo * 1.01);
+            let ratio = (hi / lo).powf(1.0 / (k - 1) as f64);
+            (0..k).map(|i| lo * ratio.powi(i as i32)).collect()
+        }
+        _ => {
+            let mut a: Vec<f64> = est
+                .iter()
+                .flat_map(|r| r.u.iter().map(|v| v.abs()))
+                .collect();
+            a.sort_by(f64::total_cmp);
+            if a.is_empty() {
+                return Vec::new();
+            }
+            let q = |p: f64| a[((a.len() - 1) as f64 * p).round() as usize];
+            let top = a[a.len() - 1];
+            let lo = q(0.1).max(1e-3 * top);
+            let mut g: Vec<f64> = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95, 0.99]
+                .iter()
+                .map(|p| q(*p))
+                .chain((0..16).map(|i| lo + (top - lo) * i as f64 / 16.0))
+                .filter(|v| *v > 0.0 && *v < top * (1.0 - 1e-9))
+                .collect();
+            g.sort_by(f64::total_cmp);
+            g.dedup_by(|a, b| (*a - *b).abs() <= 1e-6 * b.abs().max(1e-9));
+            g
+        }
+    }
+}
+
+/// The chosen actuator candidate: its re-identification and the grid/refinement trail.
+struct ActuatorChoice {
+    rep: PemReport,
+    value: f64,
+    scored: usize,
+    reidentified: usize,
+}
+
+fn choose_actuator(
+    kind: EffectKind,
+    input: &Model,
+    base: &Model,
+    est: &[Record],
+    cfg: &AugmentConfig,
+) -> Option<ActuatorChoice> {
+    let grid = actuator_grid(kind, est, input.ts);
+    if grid.is_empty() {
+        return None;
+    }
+    let score = |m: &Model| -> Vec<f64> {
+        let f = |v: &f64| frozen_cost(&m.clone().with_effect(Effect::zero(kind, *v)), est);
+        if cfg.parallel {
+            grid.par_iter().map(f).collect()
+        } else {
+            grid.iter().map(f).collect()
+        }
+    };
+    let mut pick: Vec<usize> = Vec::new();
+    for m in [input, base] {
+        let c = score(m);
+        let mut idx: Vec<usize> = (0..grid.len()).filter(|i| c[*i].is_finite()).collect();
+        idx.sort_by(|a, b| c[*a].total_cmp(&c[*b]));
+        for i in idx.into_iter().take(TOP_FROZEN) {
+            if !pick.contains(&i) {
+                pick.push(i);
+            }
+        }
+    }
+    let fit_at = |v: f64| -> Option<PemReport> {
+        let t = input.clone().with_effect(Effect::zero(kind, v));
+        let mut best = reidentify(est, &t, cfg).ok();
+        let warm = base.clone().with_effect(Effect::zero(kind, v));
+        if let Ok(w) = reidentify_warm(est, &warm, cfg) {
+            if best.as_ref().map_or(true, |b| w.cost < b.cost) {
+                best = Some(w);
+            }
+        }
+        best
+    };
+    let tried: Vec<(usize, Option<PemReport>)> = if cfg.parallel {
+        pick.par_iter().map(|&i| (i, fit_at(grid[i]))).collect()
+    } else {
+        pick.iter().map(|&i| (i, fit_at(grid[i]))).collect()
+    };
+    let mut reidentified = tried.len();
+    let (bi, brep) = tried
+        .into_iter()
+        .filter_map(|(i, r)| r.map(|r| (i, r)))
+        .min_by(|a, b| a.1.cost.total_cmp(&b.1.cost))?;
+    let mut best = ActuatorChoice {
+        value: grid[bi],
+        rep: brep,
+        scored: 2 * grid.len(),
+        reidentified,
+    };
+    if kind == EffectKind::DeadTime {
+        return Some(best);
+    }
+    // golden-section refinement between the neighbours of the best grid value
+    let lo = if bi > 0 { grid[bi - 1] } else { grid[bi] * 0.8 };
+    let hi = if bi + 1 < grid.len() {
+        grid[bi + 1]
+    } else {
+        grid[bi] * 1.2
+    };
+    let start = best.rep.model.clone();
+    let eval = |v: f64| -> (f64, Option<PemReport>) {
+        let m = start.clone().with_effect(Effect::zero(kind, v));
+        match reidentify_warm(est, &m, cfg) {
+            Ok(r) => (r.cost, Some(r)),
+            Err(_) => (f64::INFINITY, None),
+        }
+    };
+    let g = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut a, mut b) = (lo, hi);
+    let mut c = b - g * (b - a);
+    let mut d = a + g * (b - a);
+    let (mut fc, mut rc) = eval(c);
+    let (mut fd, mut rd) = eval(d);
+    reidentified += 2;
+    for _ in 0..REFINE_STEPS {
+        if fc < fd {
+            b = d;
+            d = c;
+            fd = fc;
+            rd = rc.take();
+            c = b - g * (b - a);
+            (fc, rc) = eval(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            rc = rd.take();
+            d = a + g * (b - a);
+            (fd, rd) = eval(d);
+        }
+        reidentified += 1;
+    }
+    best.reidentified = reidentified;
+    for (v, f, r) in [(c, fc, rc), (d, fd, rd)] {
+        if let Some(r) = r {
+            if f < best.rep.cost {
+                best.rep = r;
+                best.value = v;
+            }
+        }
+    }
+    Some(best)
+}
+
+/// Whether the model survives the f32 export schema and comes back with the same structure.
+fn round_trips(m: &Model) -> bool {
+    let Ok(spec) = m.to_spec() else {
+        return false;
+    };
+    let Ok(back) = Model::from_spec(&spec) else {
+        return false;
+    };
+    back.effects.len() == m.effects.len()
+        && back
+            .effects
+            .iter()
+            .zip(&m.effects)
+            .all(|(a, b)| a.kind() == b.kind())
+        && back.is_stable()
+}
+
+/// The effect in physical words.
+pub fn describe(effect: &Effect, ts: f64) -> String {
+    match *effect {
+        Effect::Bias { beta } => format!(
+            "a constant yaw moment equal to {beta:+.2}° of pod angle ({})",
+            if beta >= 0.0 {
+                "to starboard"
+            } else {
+                "to port"
+            }
+        ),
+        Effect::GyroBias { d_y } => format!("a rate-gyro offset of {d_y:+.3} °/s"),
+        Effect::DeadTime { samples } => format!(
+            "a command dead time of {samples} sample{} ({:.1} s)",
+            if samples == 1 { "" } else { "s" },
+            samples as f64 * ts
+        ),
+        Effect::RateLimit { rate } => format!("a slew limit of {rate:.1} °/s"),
+        Effect::Saturation { limit } => format!("a pod angle limit of ±{limit:.1}°"),
+        Effect::Asymmetry { beta } => format!(
+            "starboard pod deflections {:.0} % {} effective than port ones",
+            100.0 * beta.abs(),
+            if beta >= 0.0 { "more" } else { "less" }
+        ),
+        Effect::NonlinearDamping { beta, cubic } => format!(
+            "{} yaw damping beyond linear: {beta:+.4}° of pod angle per {}",
+            if beta <= 0.0 { "extra" } else { "less" },
+            if cubic {
+                "(°/s)³"
+            } else {
+                "(°/s)² of r·|r|"
+            }
+        ),
+        Effect::Wind {
+            beta_s2,
+            beta_c2,
+            beta_s1,
+            beta_c1,
+        } => format!(
+            "a heading-dependent yaw moment (wind): {:.2}° of pod angle at twice the heading \
+             frequency and {:.2}° at once",
+            beta_s2.hypot(beta_c2),
+            beta_s1.hypot(beta_c1)
+        ),
+        Effect::Current { beta_s, beta_c } => format!(
+            "a heading-dependent yaw moment (current) of {:.2}° of pod angle, largest to \
+             starboard on heading {:.0}°",
+            beta_s.hypot(beta_c),
+            beta_s.atan2(beta_c).to_degrees().rem_euclid(360.0)
+        ),
+    }
+}
+
+/// Adds `kind` to `model`, re-identifies it on `est`, and judges it on `val` (or on a
+/// held-out part of `est` when `val` is empty). See the module documentation for the method.
+///
+/// # Errors
+/// [`AugmentError::AlreadyPresent`] when the model carries the effect already;
+/// [`AugmentError::Input`] for an invalid model, no estimation records, records that do not
+/// match the model (sample time, ragged or non-finite channels, too short); and
+/// [`AugmentError::Ident`] when even the input structure cannot be re-identified. A candidate
+/// that fails to identify, is unstable or predicts non-finitely is not an error: it is
+/// reported as not kept.
+///
+/// ```
+/// use yawcast::{augment::{augment, AugmentConfig}, data::Record, model::Model, predict};
+/// use yawcast_shared::model::EffectKind;
+/// // a 2nd-order ship whose commands arrive two samples late
+/// let truth = Model::new(1.0, vec![-0.3, 0.9], vec![0.5, 0.4], vec![0.0, 0.0]).unwrap();
+/// let delayed = truth.clone().with_effect(yawcast::model::Effect::DeadTime { samples: 2 });
+/// let rec = |seed: usize| {
+///     let u: Vec<f64> = (0..400).map(|i| if ((i + seed) * 37 / 11) % 2 == 0 { 1.0 } else { -1.0 }).collect();
+///     let mut r = Record::from_uy("r", 1.0, u, vec![0.0; 400]);
+///     r.y = predict::simulate(&delayed, &r, &[0.0, 0.0]).iter().enumerate()
+///         .map(|(i, v)| v + 0.01 * ((i * 7919 + seed) % 13) as f64).collect();
+///     r
+/// };
+/// let rep = augment(&truth, EffectKind::DeadTime, &[rec(1), rec(2)], &[rec(3), rec(4)],
+///                   &AugmentConfig::default()).unwrap();
+/// assert!(rep.kept);
+/// assert_eq!(rep.model.effect(EffectKind::DeadTime),
+///            Some(&yawcast::model::Effect::DeadTime { samples: 2 }));
+/// ```
+pub fn augment(
+    model: &Model,
+    kind: EffectKind,
+    est: &[Record],
+    val: &[Record],
+    cfg: &AugmentConfig,
+) -> Result<AugmentReport, AugmentError> {
+    check_inputs(model, est, 0, "estimation")?;
+    if !val.is_empty() {
+        check_inputs(model, val, 0, "validation")?;
+    }
+    if model.effect(kind).is_some() {
+        return Err(AugmentError::AlreadyPresent(kind));
+    }
+    let (est_part, val_part, held_note) = if val.is_empty() {
+        let (e, v, note) = holdout(est, model.n)?;
+        (e, v, Some(note))
+    } else {
+        (est.to_vec(), val.to_vec(), None)
+    };
+    let mut horizons = cfg.horizons.clone();
+    for h in [Horizon::Steps(1), Horizon::Steps(10), Horizon::Sim] {
+        if !horizons.contains(&h) {
+            horizons.push(h);
+        }
+    }
+
+    // baseline: the input structure re-identified on the same estimation records
+    let base = reidentify(&est_part, model, cfg)?;
+    let before = evaluate(model, &val_part, &horizons, cfg.parallel);
+    let baseline = evaluate(&base.model, &val_part, &horizons, cfg.parallel);
+
+    // candidate
+    let (cand, search_note) = if kind.is_actuator() {
+        match choose_actuator(kind, model, &base.model, &est_part, cfg) {
+            Some(c) => {
+                let note = format!(
+                    "{} grid values scored with θ frozen, {} re-identified, best {}",
+                    c.scored,
+                    c.reidentified,
+                    describe(&Effect::zero(kind, c.value), model.ts)
+                );
+                (Some(c.rep), note)
+            }
+            None => (None, "no usable grid value".to_string()),
+        }
+    } else {
+        let t = model.clone().with_effect(Effect::zero(kind, 0.0));
+        (reidentify(&est_part, &t, cfg).ok(), String::new())
+    };
+    let Some(cand) = cand else {
+        let candidate = model.clone().with_effect(Effect::zero(kind, 1.0));
+        return Ok(failed_report(
+            kind,
+            model,
+            candidate,
+            &before,
+            &baseline,
+            &horizons,
+            held_note,
+            "the augmented model could not be identified (every start failed or went unstable)",
+        ));
+    };
+    let after = evaluate(&cand.model, &val_part, &horizons, cfg.parallel);
+
+    let extra = if kind.is_actuator() { 1.0 } else { 0.0 };
+    let nf = cand.samples as f64;
+    let delta_aic = cand.aic + 2.0 * extra - base.aic;
+    let delta_bic = cand.bic + extra * nf.ln() - base.bic;
+
+    let (g10, se10, t10) = paired(&after.units10, &baseline.units10);
+    let (gsim, sesim, tsim) = paired(&after.units_sim, &baseline.units_sim);
+    let tc = t_crit(after.units10.len().saturating_sub(1));
+    let get = |e: &Eval, k: &str| e.mean.get(k).copied().unwrap_or(f64::NAN);
+    let stable = cand.model.is_stable();
+    let exports = round_trips(&cand.model);
+    let mut reasons: Vec<String> = Vec::new();
+    if !after.finite {
+        reasons.push("its held-out predictions go non-finite".into());
+    }
+    if !stable {
+        reasons.push("it is unstable".into());
+    }
+    if stable && !exports {
+        reasons.push("it does not survive the f32 export".into());
+    }
+    if !(delta_bic < 0.0) {
+        reasons.push(format!(
+            "ΔBIC = {delta_bic:+.1} ≥ 0 on the estimation records: the extra parameter does not pay for itself"
+        ));
+    }
+    let sig = t10 > tc || tsim > tc;
+    if !sig {
+        reasons.push(format!(
+            "the held-out gain over the re-identified model ({g10:+.2} ± {se10:.2} pp at 10 steps, \
+             {gsim:+.2} ± {sesim:.2} pp in simulation) is within the record-to-record spread"
+        ));
+    }
+    if t10 < -tc || tsim < -tc {
+        reasons.push("it predicts significantly worse at 10 steps or in simulation".into());
+    }
+    for k in ["10", "sim"] {
+        if get(&after, k) < get(&before, k) {
+            reasons.push(format!(
+                "it would validate worse than the input model at {} ({:.1} < {:.1} %)",
+                if k == "sim" {
+                    "simulation".to_string()
+                } else {
+                    format!("{k} steps")
+                },
+                get(&after, k),
+                get(&before, k)
+            ));
+        }
+    }
+    let mut kept = reasons.is_empty();
+
+    // the candidate finally returned: re-fitted on the whole records when a part was held out
+    let mut cand_model = cand.model.clone();
+    let mut std_pct = cand.std_pct.clone();
+    if kept && held_note.is_some() {
+        if let Ok(full) = reidentify_warm(est, &cand.model, cfg) {
+            if full.model.is_stable() && round_trips(&full.model) {
+                cand_model = full.model;
+                std_pct = full.std_pct;
+            }
+        }
+    }
+    if kept && !round_trips(&cand_model) {
+        kept = false;
+        reasons.push("it does not survive the f32 export".into());
+    }
+    let eff = cand_model
+        .effect(kind)
+        .copied()
+        .unwrap_or(Effect::zero(kind, 0.0));
+    let mut text = format!(
+        "{}; 10-step fit {:.1} → {:.1} % on held-out records (the model re-identified without it: {:.1} %), \
+         simulation fit {:.1} → {:.1} %; ΔBIC {:+.1}",
+        describe(&eff, model.ts),
+        get(&before, "10"),
+        get(&after, "10"),
+        get(&baseline, "10"),
+        get(&before, "sim"),
+        get(&after, "sim"),
+        delta_bic
+    );
+    if !search_note.is_empty() {
+        text.push_str(&format!(" ({search_note})"));
+    }
+    if kept {
+        text.push_str(&format!(
+            ". Kept: the gain of {g10:+.2} pp at 10 steps and {gsim:+.2} pp in simulation is \
+             significant against its spread over held-out records"
+        ));
+    } else {
+        text.push_str(&format!(". Not kept: {}", reasons.join("; ")));
+        if !sig && after.finite && stable {
+            text.push_str(
+                " — the Kalman gain already re-anchors the prediction on the measured yaw rate, \
+                 so this effect adds nothing the predictor needs; the model is kept without it",
+            );
+        } else {
+            text.push_str("; the model is kept without it");
+        }
+    }
+    if let Some(n) = held_note {
+        text.push_str(&format!(". Note: {n}"));
+    }
+    text.push('.');
+    let keys: Vec<String> = horizons.iter().map(Horizon::key).collect();
+    let pick = |e: &Eval| -> BTreeMap<String, f64> {
+        keys.iter()
+            .filter(|k| cfg.horizons.iter().any(|h| &h.key() == *k) || *k == "10" || *k == "sim")
+            .map(|k| (k.clone(), get(e, k)))
+            .collect()
+    };
+    Ok(AugmentReport {
+        effect: kind,
+        model: if kept {
+            cand_model.clone()
+        } else {
+            model.clone()
+        },
+        candidate: cand_model,
+        kept,
+        before: pick(&before),
+        baseline: pick(&baseline),
+        after: pick(&after),
+        fit_gain_pp: get(&after, "10") - get(&baseline, "10"),
+        delta_aic,
+        delta_bic,
+        ljung_box_p_before: ljung_box_p(&before.resid),
+        ljung_box_p_after: ljung_box_p(&after.resid),
+        std_pct,
+        explanation: text,
+    })
+}
+
+#[allow(clippy::too_many_arguments)]
+fn failed_report(
+    kind: EffectKind,
+    model: &Model,
+    candidate: Model,
+    before: &Eval,
+    baseline: &Eval,
+    horizons: &[Horizon],
+    held_note: Option<String>,
+    why: &str,
+) -> AugmentReport {
+    let nan: BTreeMap<String, f64> = horizons.iter().map(|h| (h.key(), f64::NAN)).collect();
+    let mut text = format!(
+        "{}: not kept: {why}; the model is kept without it",
+        describe(&Effect::zero(kind, 0.0), model.ts)
+    );
+    if let Some(n) = held_note {
+        text.push_str(&format!(". Note: {n}"));
+    }
+    AugmentReport {
+        effect: kind,
+        candidate,
+        model: model.clone(),
+        kept: false,
+        before: before.mean.clone(),
+        baseline: baseline.mean.clone(),
+        after: nan,
+        fit_gain_pp: f64::NAN,
+        delta_aic: f64::NAN,
+        delta_bic: f64::NAN,
+        ljung_box_p_before: ljung_box_p(&before.resid),
+        ljung_box_p_after: f64::NAN,
+        std_pct: Vec::new(),
+        explanation: text,
+    }
+}
+
+/// Converts an identified model effect into the simulator's physical parameters, for writing
+/// it into a ship file (`--ship`). `None` when the effect has no physical counterpart in the
+/// simulator (e.g. damping identified with the wrong sign) or a calibration run fails.
+///
+/// Approximations: dead time `samples·Ts`; slew and angle limits and the gyro offset carry
+/// over unchanged; asymmetry β becomes the starboard gain `β` (the simulator scales the
+/// steering side force by `1 + β` for δ > 0, the model the effective input); see the source
+/// for the steady-state calibrations of bias and damping and the harmonic match of wind and
+/// current.
+///
+/// ```
+/// use yawcast::{augment::to_sim_effect, model::{Effect, Model}, sim::{Ship, SimEffect}};
+/// let m = Model::new(1.0, vec![-0.3, 0.9], vec![0.5, 0.4], vec![0.0, 0.0]).unwrap();
+/// let e = to_sim_effect(&Effect::DeadTime { samples: 2 }, &m, &Ship::default_lng());
+/// assert_eq!(e, Some(SimEffect::DeadTime { delay_s: 2.0 }));
+/// ```
+pub fn to_sim_effect(effect: &Effect, model: &Model, ship: &Ship) -> Option<SimEffect> {
+    let e = match *effect {
+        Effect::DeadTime { samples } => SimEffect::DeadTime {
+            delay_s: samples as f64 * model.ts,
+        },
+        Effect::RateLimit { rate } => SimEffect::RateLimit { rate_degps: rate },
+        Effect::Saturation { limit } => SimEffect::Saturation { limit_deg: limit },
+        Effect::GyroBias { d_y } => SimEffect::GyroBias { bias_degps: d_y },
+        Effect::Asymmetry { beta } => SimEffect::Asymmetry {
+            starboard_gain: beta.max(-0.95),
+        },
+        Effect::Bias { beta } => bias_to_moment(beta, ship)?,
+        Effect::NonlinearDamping { beta, cubic } => damping_to_nrr(beta, cubic, model, ship)?,
+        Effect::Wind { .. } | Effect::Current { .. } => heading_effect(effect, model, ship)?,
+    };
+    e.validate("effect").ok()?;
+    Some(e)
+}
+
+/// Steady yaw rate (deg/s) of `ship` at constant command `delta` with extra `effects`.
+fn steady_rate(ship: &Ship, delta: f64, effects: Vec<SimEffect>) -> Option<f64> {
+    let sc = Scenario {
+        name: "calibration".into(),
+        n_samples: 400,
+        input: sim::InputSpec::Constant { delta_deg: delta },
+        noise: sim::NoiseSpec::none(),
+        effects,
+        initial_heading_deg: Some(0.0),
+        ..Scenario::default()
+    };
+    let r = sim::simulate(ship, &sc, 0).ok()?;
+    let tail = &r.y[r.len() * 3 / 4..];
+    Some(tail.iter().sum::<f64>() / tail.len() as f64)
+}
+
+/// Bias β (input-equivalent degrees) → yaw moment: the moment whose steady turn equals that of
+/// δ = β (secant iterations from a test moment).
+fn bias_to_moment(beta: f64, ship: &Ship) -> Option<SimEffect> {
+    if beta == 0.0 {
+        return Some(SimEffect::Bias { yaw_moment_nm: 0.0 });
+    }
+    let r0 = steady_rate(ship, 0.0, vec![])?;
+    let target = steady_rate(ship, beta, vec![])? - r0;
+    let mut m = sim::HIDDEN_BIAS_NM * beta.signum() * (beta.abs() / 4.5);
+    for _ in 0..3 {
+        let r = steady_rate(ship, 0.0, vec![SimEffect::Bias { yaw_moment_nm: m }])? - r0;
+        if r.abs() < 1e-12 {
+            return None;
+        }
+        m *= target / r;
+    }
+    Some(SimEffect::Bias { yaw_moment_nm: m })
+}
+
+fn damping_to_nrr(beta: f64, cubic: bool, model: &Model, ship: &Ship) -> Option<SimEffect> {
+    let _ = (beta, cubic, model, ship);
+    None
+}
+
+fn heading_effect(effect: &Effect, model: &Model, ship: &Ship) -> Option<SimEffect> {
+    let _ = (effect, model, ship);
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+}
