@@ -78,25 +78,26 @@ pub enum SimEffect {
     },
 }
 
-/// Yaw moment of the default ship's pods at 1.5° at its approach speed (N·m): the hidden
-/// `bias` at full strength.
-pub const HIDDEN_BIAS_NM: f64 = 20.0;
+/// Yaw moment of the default ship's pods at about 4.5° at its approach speed (N·m): the
+/// hidden `bias` at full strength.
+pub const HIDDEN_BIAS_NM: f64 = 60.0;
 /// Hidden `gyro-bias` at full strength (deg/s).
 pub const HIDDEN_GYRO_BIAS_DEGPS: f64 = 0.25;
 /// Hidden `dead-time` at full strength (s).
 pub const HIDDEN_DEAD_TIME_S: f64 = 2.0;
 /// Hidden `rate-limit` at full strength (deg/s); strength `s` gives `rate / s`.
 pub const HIDDEN_RATE_DEGPS: f64 = 3.0;
-/// Hidden `saturation` at full strength (deg); strength `s` gives `limit / s`.
-pub const HIDDEN_LIMIT_DEG: f64 = 10.0;
+/// Hidden `saturation` at full strength (deg); strength `s` gives
+/// `20° − s·(20° − limit)` (20° is the largest identification amplitude), at least 2°.
+pub const HIDDEN_LIMIT_DEG: f64 = 8.0;
 /// Hidden `asymmetry` at full strength (relative extra effectiveness to starboard).
 pub const HIDDEN_ASYMMETRY: f64 = 0.4;
 /// Hidden `nonlinear-damping` at full strength (non-dimensional `n_rr`).
-pub const HIDDEN_N_RR: f64 = 0.5;
-/// Hidden `wind` at full strength (m/s at model scale; Beaufort 4–5 Froude-scaled by √24).
-pub const HIDDEN_WIND_MPS: f64 = 2.0;
+pub const HIDDEN_N_RR: f64 = 0.15;
+/// Hidden `wind` at full strength (m/s at model scale; 14.7 m/s, Beaufort 7, Froude-scaled by √24).
+pub const HIDDEN_WIND_MPS: f64 = 3.0;
 /// Hidden `current` at full strength (m/s at model scale).
-pub const HIDDEN_CURRENT_MPS: f64 = 0.25;
+pub const HIDDEN_CURRENT_MPS: f64 = 0.3;
 
 impl SimEffect {
     /// The library kind of this effect.
@@ -125,11 +126,12 @@ impl SimEffect {
     ///
     /// At full strength each effect visibly degrades a linear model's long-horizon yaw-rate
     /// prediction on trial-like records of the default ship while staying physically
-    /// plausible: bias 20 N·m (≈ the pods' moment at 1.5°), gyro bias 0.25 °/s, dead time
-    /// 2 s, slew limit 3 °/s, angle limit 10°, asymmetry +40 % to starboard, extra Norrbin
-    /// damping `n_rr` = 0.5, wind 2 m/s from 045° (Beaufort 4–5 Froude-scaled), current
-    /// 0.25 m/s setting towards 090°. Additive effects scale linearly with `strength`; the
-    /// slew and angle limits are divided by it. A `strength` at or below zero is taken as
+    /// plausible: bias 60 N·m (≈ the pods' moment at 4.5°), gyro bias 0.25 °/s, dead time
+    /// 2 s, slew limit 3 °/s, angle limit 8°, asymmetry +40 % to starboard, extra Norrbin
+    /// damping `n_rr` = 0.15, wind 3 m/s from 045° (Beaufort 7 Froude-scaled), current
+    /// 0.3 m/s setting towards 090°. Additive effects scale linearly with `strength`; the
+    /// slew limit is divided by it; the angle limit moves from 20° (the largest
+    /// identification amplitude) towards 8°. A `strength` at or below zero is taken as
     /// 1e-6 (practically no effect); a non-finite one gives parameters that
     /// [`simulate`](super::simulate) rejects. A library kind the simulator has no physics
     /// for gives a zero bias (no effect).
@@ -166,7 +168,7 @@ impl SimEffect {
                 rate_degps: HIDDEN_RATE_DEGPS / s,
             },
             EffectKind::Saturation => SimEffect::Saturation {
-                limit_deg: HIDDEN_LIMIT_DEG / s,
+                limit_deg: (20.0 - s * (20.0 - HIDDEN_LIMIT_DEG)).max(2.0),
             },
             EffectKind::Asymmetry => SimEffect::Asymmetry {
                 starboard_gain: HIDDEN_ASYMMETRY * s,
@@ -259,7 +261,7 @@ mod tests {
             .is_err());
         assert_eq!(
             SimEffect::hidden(EffectKind::Saturation, 0.5),
-            SimEffect::Saturation { limit_deg: 20.0 }
+            SimEffect::Saturation { limit_deg: 14.0 }
         );
     }
 

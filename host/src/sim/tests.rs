@@ -1,29 +1,155 @@
 //! Acceptance tests of the simulator: manoeuvres, effects, seeds, errors.
 
 use super::*;
-use crate::{pem, predict::{self, Horizon}};
+use crate::predict::{self, Horizon};
 use yawcast_shared::model::EffectKind;
 
 #[test]
-fn probe() {
+fn turning_circle_and_zigzag_look_like_a_ship() {
     let ship = Ship::default_lng();
-    let train: Vec<_> = (1..=3).map(|s| simulate(&ship, &Scenario::default(), s).unwrap()).collect();
-    let rep = pem::identify(&train, None, &pem::PemConfig::default()).unwrap();
-    let m = rep.model;
-    let hs = [Horizon::Steps(10), Horizon::Steps(50), Horizon::Sim];
-    let eval = |sc: &Scenario| -> Vec<f64> {
-        let mut acc = vec![0.0; hs.len()];
-        for seed in 100..104 {
-            let r = simulate(&ship, sc, seed).unwrap();
-            for (i, h) in hs.iter().enumerate() { acc[i] += predict::fit_at(&m, &r, *h) / 4.0; }
-        }
-        acc
-    };
-    println!("ref {:?}", eval(&Scenario::default()));
-    for k in EffectKind::ALL {
-        for s in [0.5, 1.0] {
-            let sc = Scenario::with_effect(SimEffect::hidden(k, s));
-            println!("{} {s} {:?}", k.name(), eval(&sc));
-        }
+    let l = ship.main.lpp_m;
+    let tc = turning_circle(&ship, 35.0).unwrap();
+    println!("35° turning circle: {tc:?} (Lpp {l} m)");
+    assert!(
+        (2.0 * l..6.0 * l).contains(&tc.tactical_diameter_m),
+        "tactical diameter {} m",
+        tc.tactical_diameter_m
+    );
+    assert!(
+        (2.0 * l..6.0 * l).contains(&tc.advance_m),
+        "advance {} m",
+        tc.advance_m
+    );
+    // Port and starboard turns mirror each other on a symmetric ship.
+    let port = turning_circle(&ship, -35.0).unwrap();
+    assert!((port.tactical_diameter_m - tc.tactical_diameter_m).abs() < 0.01 * l);
+    assert!(port.steady_r_degps < 0.0 && tc.steady_r_degps > 0.0);
+    // The ship slows down in the turn.
+    assert!(tc.steady_speed_mps > 0.0);
+
+    let z = zigzag(&ship, 10.0, 10.0).unwrap();
+    println!("10/10 zig-zag: {z:?}");
+    assert!(
+        (2.0..20.0).contains(&z.first_overshoot_deg),
+        "first overshoot {}°",
+        z.first_overshoot_deg
+    );
+    assert!(z.second_overshoot_deg > 0.0 && z.time_to_switch_s > 0.0);
+}
+
+#[test]
+fn steady_yaw_rate_grows_with_the_pod_angle() {
+    let ship = Ship::default_lng();
+    let rates: Vec<f64> = [5.0, 10.0, 20.0, 35.0]
+        .iter()
+        .map(|&d| turning_circle(&ship, d).unwrap().steady_r_degps)
+        .collect();
+    println!("steady r at 5/10/20/35°: {rates:?}");
+    for w in rates.windows(2) {
+        assert!(w[1] > w[0] * 1.05, "{rates:?}");
     }
+}
+
+fn quiet(effects: Vec<SimEffect>) -> Scenario {
+    Scenario {
+        noise: NoiseSpec::none(),
+        initial_heading_deg: Some(30.0),
+        n_samples: 900,
+        effects,
+        ..Scenario::default()
+    }
+}
+
+#[test]
+fn every_effect_changes_the_output_and_the_seed_fixes_the_record() {
+    let ship = Ship::default_lng();
+    let base = simulate(&ship, &quiet(Vec::new()), 7).unwrap();
+    assert_eq!(base, simulate(&ship, &quiet(Vec::new()), 7).unwrap());
+    assert_ne!(base.u, simulate(&ship, &quiet(Vec::new()), 8).unwrap().u);
+    for k in EffectKind::ALL {
+        let rec = simulate(&ship, &quiet(vec![SimEffect::hidden(k, 1.0)]), 7).unwrap();
+        assert_eq!(rec.u, base.u, "{}: same command", k.name());
+        // Yaw rate, heading or speed over ground must differ measurably.
+        let dy = max_abs_diff(&rec.y, &base.y);
+        let dpsi = max_abs_diff(rec.psi.as_ref().unwrap(), base.psi.as_ref().unwrap());
+        let dv = max_abs_diff(rec.speed.as_ref().unwrap(), base.speed.as_ref().unwrap());
+        println!(
+            "{}: Δr {dy:.4} °/s, Δψ {dpsi:.2}°, ΔU {dv:.4} m/s",
+            k.name()
+        );
+        assert!(
+            dy > 0.02 || dpsi > 1.0 || dv > 0.01,
+            "{} changes nothing",
+            k.name()
+        );
+    }
+}
+
+fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()))
+}
+
+#[test]
+fn hidden_effects_cost_a_linear_model_fit_or_show_in_the_channels() {
+    // A model identified on effect-free records predicts effect-free held-out records well;
+    // on records with a full-strength hidden effect that changes the yaw dynamics it
+    // predicts worse at 10 steps.
+    let ship = Ship::default_lng();
+    let sc = Scenario::default();
+    let train = simulate_many(&ship, &sc, &[1, 2, 3]).unwrap();
+    let m = crate::pem::identify(&train, None, &crate::pem::PemConfig::default())
+        .unwrap()
+        .model;
+    // Slow effects (bias, gyro bias) show at long horizons: the Kalman gain re-anchors
+    // short predictions.
+    let fits = |sc: &Scenario| -> [f64; 2] {
+        let recs = simulate_many(&ship, sc, &[101, 102]).unwrap();
+        let mut f = [0.0; 2];
+        for r in &recs {
+            f[0] += predict::fit_at(&m, r, Horizon::Steps(10)) / recs.len() as f64;
+            f[1] += predict::fit_at(&m, r, Horizon::Steps(50)) / recs.len() as f64;
+        }
+        f
+    };
+    let clean = fits(&sc);
+    println!("effect-free held-out fit at 10/50 steps {clean:.2?} %");
+    assert!(clean[0] > 80.0, "{clean:?}");
+    for k in [
+        EffectKind::Bias,
+        EffectKind::GyroBias,
+        EffectKind::DeadTime,
+        EffectKind::RateLimit,
+        EffectKind::Saturation,
+        EffectKind::Asymmetry,
+        EffectKind::NonlinearDamping,
+    ] {
+        let f = fits(&Scenario::with_effect(SimEffect::hidden(k, 1.0)));
+        println!("{}: fit at 10/50 steps {f:.2?} %", k.name());
+        let cost = (clean[0] - f[0]).max(clean[1] - f[1]);
+        assert!(cost > 2.0, "{} costs only {cost:.2} pp", k.name());
+    }
+}
+
+#[test]
+fn bad_scenarios_name_the_field() {
+    let ship = Ship::default_lng();
+    let e = simulate(
+        &ship,
+        &Scenario {
+            ts: -1.0,
+            ..Scenario::default()
+        },
+        1,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("scenario.ts"), "{e}");
+    let e = simulate(
+        &ship,
+        &Scenario::with_effect(SimEffect::RateLimit { rate_degps: 0.0 }),
+        1,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("rate_degps"), "{e}");
 }
