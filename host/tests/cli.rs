@@ -604,3 +604,116 @@ fn identify_average_export_compare_chain() {
     assert!(stderr(&o).contains("constant"), "{}", stderr(&o));
     assert!(!d.join("never.postcard").exists());
 }
+
+#[test]
+fn simulate_writes_seeded_records_with_the_effect_and_the_ship_file() {
+    let d = scratch("simulate");
+    let out = d.join("trial.csv");
+    let json = d.join("sim.json");
+    let ship = d.join("ship.toml");
+    let args = |o: &Path| {
+        vec![
+            "simulate".to_string(),
+            "--seed".into(),
+            "11".into(),
+            "--effect".into(),
+            "rate-limit".into(),
+            "--duration".into(),
+            "300".into(),
+            "--records".into(),
+            "2".into(),
+            "--out".into(),
+            o.display().to_string(),
+        ]
+    };
+    let mut a = args(&out);
+    a.extend([
+        "--json".into(),
+        json.display().to_string(),
+        "--save-ship".into(),
+        ship.display().to_string(),
+    ]);
+    let o = bin().args(&a).output().unwrap();
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(stderr(&o).contains("seed 11"));
+    let first = std::fs::read_to_string(d.join("trial-1.csv")).unwrap();
+    assert!(first.starts_with("t_s,delta_deg,r_degps,psi_deg,u_mps\n"));
+    assert_eq!(first.lines().count(), 301);
+    // Same seed, same bytes; the second record has the next seed.
+    let again = d.join("again.csv");
+    let o = bin().args(args(&again)).output().unwrap();
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert_eq!(
+        first,
+        std::fs::read_to_string(d.join("again-1.csv")).unwrap()
+    );
+    assert_ne!(
+        first,
+        std::fs::read_to_string(d.join("trial-2.csv")).unwrap()
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["seed"], 11);
+    assert_eq!(v["effects"][0]["kind"], "rate-limit");
+    assert_eq!(v["effects"][0]["rate_degps"], 3.0);
+    assert_eq!(v["records"][1]["seed"], 12);
+    assert_eq!(v["records"][0]["samples"], 300);
+    let toml = std::fs::read_to_string(&ship).unwrap();
+    assert!(toml.contains("kind = \"rate-limit\""), "{toml}");
+    // The written ship file drives the simulator again.
+    let o = run(&[
+        "simulate",
+        "--ship",
+        ship.to_str().unwrap(),
+        "--seed",
+        "11",
+        "--duration",
+        "300",
+        "--records",
+        "2",
+        "--out",
+        d.join("fromship.csv").to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert_eq!(
+        first,
+        std::fs::read_to_string(d.join("fromship-1.csv")).unwrap()
+    );
+}
+
+#[test]
+fn simulate_rejects_bad_arguments_with_exit_2() {
+    let d = scratch("simulate-bad");
+    let out = d.join("x.csv");
+    let o = run(&[
+        "simulate",
+        "--effect",
+        "gremlins",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 2);
+    assert!(stderr(&o).contains("gremlins") && stderr(&o).contains("dead-time"));
+    let o = run(&[
+        "simulate",
+        "--input",
+        "zigzag:10",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 2);
+    assert!(stderr(&o).contains("--input"));
+    let o = run(&["simulate", "--ts", "-1", "--out", out.to_str().unwrap()]);
+    assert_eq!(code(&o), 2);
+    let bad_ship = d.join("bad.toml");
+    std::fs::write(&bad_ship, "name = \"x\"\n[main]\nloa_m = -3\n").unwrap();
+    let o = run(&[
+        "simulate",
+        "--ship",
+        bad_ship.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(!out.exists());
+}

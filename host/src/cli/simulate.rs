@@ -1,16 +1,227 @@
-//! `yawcast simulate` (being written).
+//! `yawcast simulate`: measurement records from the 3-DOF ship simulator, one effect or more
+//! switched on, seeded.
 
-use anyhow::Result;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use clap::Args;
+use serde::Serialize;
+use yawcast::sim::{self, InputSpec, NoiseSpec, Scenario, Ship, SimEffect};
+use yawcast_shared::model::EffectKind;
+
+use super::common::{bad, JsonArg, SeedArg};
 
 /// Arguments of `yawcast simulate`.
-#[derive(Debug, clap::Args)]
+#[derive(Debug, Args)]
 pub struct SimulateArgs {
-    /// Everything after the subcommand.
-    #[arg(trailing_var_arg = true, allow_hyphen_values = true, hide = true)]
-    pub rest: Vec<String>,
+    /// Ship file (TOML; copy `host/ships/lng_1to24.toml` or write it with `--save-ship`).
+    /// Default: the built-in 1:24 LNG carrier.
+    #[arg(long, value_name = "SHIP.toml")]
+    pub ship: Option<PathBuf>,
+    /// Switch on a library effect at its canonical strength (repeatable): bias, gyro-bias,
+    /// dead-time, rate-limit, saturation, asymmetry, nonlinear-damping, wind, current.
+    #[arg(long, value_name = "NAME")]
+    pub effect: Vec<String>,
+    /// Strength of the `--effect`s (1 full, 0.5 half).
+    #[arg(long, value_name = "S", default_value_t = 1.0)]
+    pub strength: f64,
+    /// Record length (s).
+    #[arg(long, value_name = "S", default_value_t = 1800.0)]
+    pub duration: f64,
+    /// Sample time (s).
+    #[arg(long, value_name = "S", default_value_t = 1.0)]
+    pub ts: f64,
+    /// Command: `prbs` (identification input, random switching, 5–20°), `zigzag:10/10`,
+    /// `step:15` (step at t = 10 s) or `constant:10`.
+    #[arg(long, value_name = "KIND", default_value = "prbs")]
+    pub input: String,
+    /// Rate-gyro noise (deg/s, standard deviation).
+    #[arg(long, value_name = "DEG/S", default_value_t = 0.03)]
+    pub gyro_noise: f64,
+    /// Heading noise (deg, standard deviation).
+    #[arg(long, value_name = "DEG", default_value_t = 0.0)]
+    pub heading_noise: f64,
+    /// Speed-over-ground noise (m/s, standard deviation).
+    #[arg(long, value_name = "M/S", default_value_t = 0.0)]
+    pub speed_noise: f64,
+    /// Initial heading (deg); drawn from the seed when not given.
+    #[arg(long, value_name = "DEG")]
+    pub heading: Option<f64>,
+    /// Log the apparent wind (anemometer) columns.
+    #[arg(long)]
+    pub log_wind: bool,
+    /// Number of records (seeds `seed`, `seed+1`, …); with more than one, `-1`, `-2`, … is
+    /// added to the file name before its extension.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub records: usize,
+    /// The measurement CSV to write.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Also write the ship used (with its effects) as TOML, to copy and edit.
+    #[arg(long, value_name = "SHIP.toml")]
+    pub save_ship: Option<PathBuf>,
+    #[command(flatten)]
+    pub seed: SeedArg,
+    #[command(flatten)]
+    pub json: JsonArg,
+}
+
+/// One written record in the JSON summary.
+#[derive(Debug, Serialize)]
+struct Written {
+    path: String,
+    seed: u64,
+    samples: usize,
+    ts: f64,
+}
+
+/// The JSON summary of `yawcast simulate`.
+#[derive(Debug, Serialize)]
+struct Summary {
+    command: &'static str,
+    seed: u64,
+    ship: String,
+    effects: Vec<SimEffect>,
+    records: Vec<Written>,
+}
+
+fn parse_input(s: &str) -> Result<InputSpec> {
+    let err = || {
+        bad(format!(
+            "--input {s:?}: expected prbs, zigzag:DELTA/PSI, step:DELTA or constant:DELTA"
+        ))
+    };
+    let (kind, arg) = s.split_once(':').unwrap_or((s, ""));
+    let num = |v: &str| v.trim().parse::<f64>().map_err(|_| err());
+    Ok(match kind {
+        "prbs" if arg.is_empty() => InputSpec::default(),
+        "zigzag" => {
+            let (d, p) = arg.split_once('/').ok_or_else(err)?;
+            InputSpec::ZigZag {
+                delta_deg: num(d)?,
+                psi_deg: num(p)?,
+            }
+        }
+        "step" => InputSpec::Step {
+            delta_deg: num(arg)?,
+            at_s: 10.0,
+        },
+        "constant" => InputSpec::Constant {
+            delta_deg: num(arg)?,
+        },
+        _ => return Err(err()),
+    })
+}
+
+/// Path of record `i` (1-based) of `n`.
+fn numbered(out: &Path, i: usize, n: usize) -> PathBuf {
+    if n == 1 {
+        return out.to_path_buf();
+    }
+    let stem = out
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let name = match out.extension() {
+        Some(ext) => format!("{stem}-{i}.{}", ext.to_string_lossy()),
+        None => format!("{stem}-{i}"),
+    };
+    out.with_file_name(name)
 }
 
 /// Runs `yawcast simulate`.
-pub fn run(_args: &SimulateArgs) -> Result<()> {
-    anyhow::bail!("`yawcast simulate` is not available in this build")
+pub fn run(args: &SimulateArgs) -> Result<()> {
+    let ship = match &args.ship {
+        Some(p) => Ship::from_file(p).map_err(bad)?,
+        None => Ship::default_lng(),
+    };
+    let mut effects = Vec::new();
+    for name in &args.effect {
+        let kind = EffectKind::from_name(name).ok_or_else(|| {
+            let names: Vec<&str> = EffectKind::ALL.iter().map(|k| k.name()).collect();
+            bad(format!(
+                "--effect {name:?}: unknown effect (expected one of {})",
+                names.join(", ")
+            ))
+        })?;
+        effects.push(SimEffect::hidden(kind, args.strength));
+    }
+    if !(args.strength.is_finite() && args.strength > 0.0) {
+        return Err(bad(format!(
+            "--strength {}: expected a positive number",
+            args.strength
+        )));
+    }
+    if !(args.duration.is_finite() && args.ts.is_finite() && args.ts > 0.0 && args.duration > 0.0) {
+        return Err(bad("--duration and --ts must be positive numbers"));
+    }
+    let n_samples = (args.duration / args.ts).round() as usize;
+    if args.records == 0 {
+        return Err(bad("--records: expected at least 1"));
+    }
+    if args.out.is_none() && args.save_ship.is_none() {
+        return Err(bad(
+            "nothing to write: give --out FILE.csv (and/or --save-ship)",
+        ));
+    }
+    let scenario = Scenario {
+        name: "sim".into(),
+        ts: args.ts,
+        n_samples,
+        input: parse_input(&args.input)?,
+        noise: NoiseSpec {
+            gyro_std_degps: args.gyro_noise,
+            heading_std_deg: args.heading_noise,
+            speed_std_mps: args.speed_noise,
+        },
+        effects: effects.clone(),
+        log_wind: args.log_wind,
+        initial_heading_deg: args.heading,
+        ..Scenario::default()
+    };
+    scenario.validate().map_err(bad)?;
+    let seed = args.seed.resolve();
+    let mut written = Vec::new();
+    if let Some(out) = &args.out {
+        let seeds: Vec<u64> = (0..args.records as u64).map(|i| seed + i).collect();
+        let recs = sim::simulate_many(&ship, &scenario, &seeds).map_err(bad)?;
+        for (i, (rec, s)) in recs.iter().zip(&seeds).enumerate() {
+            let path = numbered(out, i + 1, args.records);
+            yawcast::data::write_csv(&path, rec)
+                .with_context(|| format!("writing {}", path.display()))?;
+            println!(
+                "{}: {} samples at Ts = {} s, seed {s}",
+                path.display(),
+                rec.len(),
+                rec.ts
+            );
+            written.push(Written {
+                path: path.display().to_string(),
+                seed: *s,
+                samples: rec.len(),
+                ts: rec.ts,
+            });
+        }
+    }
+    let mut ship_out = ship.clone();
+    for e in &effects {
+        ship_out = ship_out.with_effect(*e);
+    }
+    if let Some(p) = &args.save_ship {
+        let text = ship_out.to_toml_string().map_err(bad)?;
+        yawcast::data::write_atomic(p, text.as_bytes())
+            .with_context(|| format!("writing the ship file {}", p.display()))?;
+        println!("{}: ship file ({})", p.display(), ship_out.name);
+    }
+    if !effects.is_empty() {
+        let names: Vec<&str> = effects.iter().map(|e| e.kind().name()).collect();
+        println!("effects on: {}", names.join(", "));
+    }
+    args.json.write(&Summary {
+        command: "simulate",
+        seed,
+        ship: ship.name.clone(),
+        effects,
+        records: written,
+    })
 }
