@@ -326,14 +326,7 @@ impl Model {
         let vdot = self.minv_vr[0][0] * fv + self.minv_vr[0][1] * fr;
         let rdot = self.minv_vr[1][0] * fv + self.minv_vr[1][1] * fr;
         let (sp, cp) = psi.sin_cos();
-        [
-            udot,
-            vdot,
-            rdot,
-            u * cp - v * sp,
-            u * sp + v * cp,
-            r,
-        ]
+        [udot, vdot, rdot, u * cp - v * sp, u * sp + v * cp, r]
     }
 
     /// One RK4 step of length `dt` with the pod angle held at `delta` (rad).

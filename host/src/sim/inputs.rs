@@ -149,14 +149,7 @@ impl InputSpec {
                 amplitudes_deg,
                 min_hold_s,
                 max_hold_s,
-            } => Some(prbs(
-                n,
-                ts,
-                amplitudes_deg,
-                *min_hold_s,
-                *max_hold_s,
-                seed,
-            )),
+            } => Some(prbs(n, ts, amplitudes_deg, *min_hold_s, *max_hold_s, seed)),
             InputSpec::Step { delta_deg, at_s } => Some(
                 (0..n)
                     .map(|k| {

@@ -64,7 +64,11 @@ fn settled(ship: &Ship) -> RunSpec<'_> {
 pub fn turning_circle(ship: &Ship, delta_deg: f64) -> Result<TurningResult, SimError> {
     ship.validate()?;
     if !delta_deg.is_finite() || delta_deg == 0.0 {
-        return Err(SimError::invalid("delta_deg", delta_deg, "finite and non-zero"));
+        return Err(SimError::invalid(
+            "delta_deg",
+            delta_deg,
+            "finite and non-zero",
+        ));
     }
     let sg = delta_deg.signum();
     let spec = settled(ship);

@@ -408,7 +408,11 @@ mod tests {
             ("mass_kg = 6999.0", "mass_kg = -1.0", "main.mass_kg"),
             ("k_zz = 0.25", "k_zz = 3.0", "main.k_zz"),
             ("wake = 0.25", "wake = 1.5", "pods.wake"),
-            ("max_angle_deg = 35.0", "max_angle_deg = 0.0", "actuator.max_angle_deg"),
+            (
+                "max_angle_deg = 35.0",
+                "max_angle_deg = 0.0",
+                "actuator.max_angle_deg",
+            ),
             ("n_r = -0.0393", "n_r = inf", "hull.n_r"),
             ("count = 2", "count = 0", "pods.count"),
             // wrong type, unknown key: the TOML layer names the key
@@ -422,9 +426,8 @@ mod tests {
             let e = Ship::from_toml_str(&txt).unwrap_err().to_string();
             assert!(e.contains(field), "{to}: {e}");
         }
-        let txt = format!(
-            "{DEFAULT_SHIP_TOML}\n[[effects]]\nkind = \"rate-limit\"\nrate_degps = -2.0\n"
-        );
+        let txt =
+            format!("{DEFAULT_SHIP_TOML}\n[[effects]]\nkind = \"rate-limit\"\nrate_degps = -2.0\n");
         let e = Ship::from_toml_str(&txt).unwrap_err().to_string();
         assert!(e.contains("effects[0] (rate-limit).rate_degps"), "{e}");
         let txt = format!("{DEFAULT_SHIP_TOML}\n[[effects]]\nkind = \"waves\"\n");
