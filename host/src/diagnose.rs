@@ -1,1 +1,1775 @@
-//! Placeholder for the `diagnose` module (being written).
+//! Which physical effect is the model missing? Evidence for every library effect on the
+//! trial records *and* on the reference records the model was identified from; the verdict
+//! names what the trials have that the reference lacks, or `none`.
+//!
+//! The method (DESIGN.md, "what works"):
+//!
+//! - **Frozen linear part.** θ stays at the model's values; each effect is added with its
+//!   structural parameter on a grid (dead time d, slew rate ρ, clip level, `y|y|` or `y³`)
+//!   and its linear gains fitted by least squares on the prediction errors (one-step errors
+//!   for actuator and hull effects, ≈ 50-step errors for the slow effects bias, gyro bias,
+//!   wind and current). The likelihood statistic is `N·ln(SSE₀/SSE₁)`, maximised over the grid.
+//! - **Difference against the reference.** The same fit on the reference records gives the
+//!   version of the effect the reference already shows (a linear model of a nonlinear hull
+//!   shows "nonlinear damping" on any data). The trial statistic is measured from that
+//!   version: `D = N·ln(SSE(reference version)/SSE(trial's best))`.
+//! - **Null distribution by parametric bootstrap.** The innovations model with the
+//!   reference version of the effect is simulated with the reference's innovation variance on
+//!   the trial inputs; `D` is recomputed on each replicate and a scaled χ² is fitted to the
+//!   replicates (Satterthwaite), which gives the p-value. No threshold is set by hand: an
+//!   effect is *significant* at level α.
+//! - **Every channel.** Heading separates a gyro bias from a yaw moment: over a record,
+//!   `mean(r) − mean(dψ/dt)` equals the rate-sensor offset and is ≈ 0 for a true moment.
+//!   Speed over ground modulated with heading (harmonics in ψ) reveals current and wind.
+//!   Standard errors of these channel statistics come from block (batch-means) sums, so
+//!   slow disturbances are accounted for.
+//! - **Encompassing test between the top two**: both effects fitted jointly; what each adds
+//!   given the other decides between look-alikes (dead time vs slew limit, bias vs current
+//!   vs wind).
+//! - **Significant and material.** An effect is reported when it is significant and, refitted
+//!   by PEM with the effect (see [`crate::augment`]), improves held-out prediction — or, for
+//!   effects the yaw prediction cannot see well, when its own channel shows it (heading for
+//!   a gyro bias, speed over ground for current and wind).
+//!
+//! Effects already in the model are skipped, so diagnosing an augmented model looks for the
+//! next one.
+
+use std::collections::BTreeMap;
+
+use nalgebra::{DMatrix, DVector};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use serde::Serialize;
+use thiserror::Error;
+use yawcast_shared::model::EffectKind;
+
+use crate::augment::{AugmentConfig, AugmentReport};
+use crate::compare::{check_inputs, mean_fit, InputError};
+use crate::data::Record;
+use crate::model::{Effect, Model};
+use crate::pem::{self, PemConfig};
+use crate::predict::{self, Horizon, Stepper};
+use crate::resid::{chi2_sf, normal_sf};
+
+/// Horizon (samples) of the prediction errors the slow effects are fitted on.
+pub const SLOW_HORIZON: usize = 50;
+/// Every `SLOW_STRIDE`-th sample's 50-step error is used (they overlap heavily anyway).
+const SLOW_STRIDE: usize = 10;
+/// Shortest record `diagnose` accepts (samples): a few slow-horizon windows.
+pub const MIN_SAMPLES: usize = 4 * SLOW_HORIZON;
+
+/// Settings of [`diagnose`].
+#[derive(Debug, Clone)]
+pub struct DiagnoseConfig {
+    /// Seed of the parametric bootstrap (ChaCha8).
+    pub seed: u64,
+    /// Bootstrap replicates per effect for the null distributions.
+    pub null_reps: usize,
+    /// Significance level (default 0.01).
+    pub alpha: f64,
+    /// Refit the top candidate(s) with the effect ([`crate::augment::augment`]) and judge
+    /// materiality on held-out records.
+    pub confirm: bool,
+    /// Settings of the confirming refit.
+    pub augment: AugmentConfig,
+    /// Use rayon.
+    pub parallel: bool,
+}
+
+impl Default for DiagnoseConfig {
+    fn default() -> Self {
+        DiagnoseConfig {
+            seed: 1,
+            null_reps: 24,
+            alpha: 0.01,
+            confirm: true,
+            augment: AugmentConfig::default(),
+            parallel: true,
+        }
+    }
+}
+
+/// One effect's evidence.
+#[derive(Debug, Clone, Serialize)]
+pub struct Ranked {
+    /// Effect name ([`EffectKind::name`]).
+    pub effect: String,
+    /// Test statistic (likelihood statistic on the yaw channel, or the channel's χ² where that
+    /// decides).
+    pub statistic: f64,
+    /// p-value against the calibrated null.
+    pub p_value: f64,
+    /// Held-out fit gain (percentage points, at the effect's horizon: 10 steps for actuator and
+    /// hull effects, `sim` for slow ones) of the refit model; 0 when not refitted.
+    pub fit_gain_pp: f64,
+    /// p-value below α.
+    pub significant: bool,
+    /// Held-out improvement on refit, or measurable channel evidence.
+    pub material: bool,
+    /// The effect's estimated structural parameter in physical units, where it has one
+    /// (dead time s, slew °/s, clip level °, gyro bias °/s, current m/s of speed over ground).
+    pub parameter: Option<f64>,
+    /// The evidence in words.
+    pub evidence: String,
+}
+
+/// The outcome of [`diagnose`].
+#[derive(Debug, Clone, Serialize)]
+pub struct Diagnosis {
+    /// The effect name, or `"none"`.
+    pub verdict: String,
+    /// Every library effect not already in the model, best first.
+    pub ranking: Vec<Ranked>,
+    /// The verdict in physical words, with numbers.
+    pub explanation: String,
+    /// Whether reference records were given.
+    pub reference_used: bool,
+    /// The confirming refit of the verdict's effect, when done.
+    pub augment: Option<AugmentReport>,
+    /// Held-out fit % of the model, keyed by horizon ("1","5","10","20","sim").
+    pub before: BTreeMap<String, f64>,
+    /// Held-out fit % of the model with the verdict's effect (same as `before` when `none`).
+    pub after: BTreeMap<String, f64>,
+}
+
+impl Diagnosis {
+    /// The verdict as an effect kind (`None` for `"none"`).
+    ///
+    /// ```
+    /// use yawcast::diagnose::Diagnosis;
+    /// use yawcast_shared::model::EffectKind;
+    /// let d = Diagnosis {
+    ///     verdict: "dead-time".into(), ranking: vec![], explanation: String::new(),
+    ///     reference_used: true, augment: None, before: Default::default(), after: Default::default(),
+    /// };
+    /// assert_eq!(d.verdict_kind(), Some(EffectKind::DeadTime));
+    /// ```
+    pub fn verdict_kind(&self) -> Option<EffectKind> {
+        EffectKind::from_name(&self.verdict)
+    }
+}
+
+/// Errors of [`diagnose`].
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum DiagnoseError {
+    /// Bad model or records (names the record and channel).
+    #[error(transparent)]
+    Input(#[from] InputError),
+    /// The trial and reference records disagree with each other.
+    #[error("{0}")]
+    Mismatch(String),
+}
+
+// ---------------------------------------------------------------------------------------
+// prediction errors and their sensitivities
+
+fn horizon_of(kind: EffectKind) -> usize {
+    match kind {
+        EffectKind::Bias | EffectKind::GyroBias | EffectKind::Wind | EffectKind::Current => {
+            SLOW_HORIZON
+        }
+        _ => 1,
+    }
+}
+
+/// Prediction errors `y − ŷ` at horizon `h` (all samples for h = 1; every
+/// [`SLOW_STRIDE`]-th sample from `h` on otherwise). Open-loop steps use the measured heading.
+fn errors(model: &Model, rec: &Record, x0: &[f64], h: usize) -> Vec<f64> {
+    let s = Stepper::new(model);
+    let psi = |t: usize| rec.psi.as_ref().map(|p| p[t]);
+    let p0 = psi(0).unwrap_or(0.0);
+    let mut st = s.initial(x0, p0);
+    let n = rec.len();
+    if h <= 1 {
+        return (0..n)
+            .map(|t| rec.y[t] - s.step(&mut st, rec.u[t], rec.y[t], psi(t)).yhat)
+            .collect();
+    }
+    let mut states = Vec::with_capacity(n);
+    for t in 0..n {
+        states.push(st.clone());
+        s.step(&mut st, rec.u[t], rec.y[t], psi(t));
+    }
+    let mut out = Vec::with_capacity(n / SLOW_STRIDE + 1);
+    let mut t = h;
+    while t < n {
+        let start = t + 1 - h;
+        let mut w = states[start].clone();
+        for j in start..t {
+            s.step(&mut w, rec.u[j], f64::NAN, psi(j));
+        }
+        out.push(rec.y[t] - s.output(&w));
+        t += SLOW_STRIDE;
+    }
+    out
+}
+
+/// Least-squares pieces of one candidate on a set of records: `e₀ᵀe₀`, `Sᵀe₀`, `SᵀS` with
+/// `S` the sensitivities of ŷ to the effect's gains (so `SSE(β) = ‖e₀ − Sβ‖²`).
+#[derive(Debug, Clone)]
+struct Quad {
+    ee: f64,
+    se: DVector<f64>,
+    ss: DMatrix<f64>,
+    n: usize,
+}
+
+impl Quad {
+    fn zero(p: usize) -> Quad {
+        Quad {
+            ee: 0.0,
+            se: DVector::zeros(p),
+            ss: DMatrix::zeros(p, p),
+            n: 0,
+        }
+    }
+
+    fn add(&mut self, o: &Quad) {
+        self.ee += o.ee;
+        self.se += &o.se;
+        self.ss += &o.ss;
+        self.n += o.n;
+    }
+
+    fn sse(&self, beta: &DVector<f64>) -> f64 {
+        if beta.is_empty() {
+            return self.ee;
+        }
+        (self.ee - 2.0 * beta.dot(&self.se) + beta.dot(&(&self.ss * beta))).max(1e-300)
+    }
+
+    fn best(&self) -> (DVector<f64>, f64) {
+        let p = self.se.len();
+        if p == 0 {
+            return (DVector::zeros(0), self.ee.max(1e-300));
+        }
+        let mut a = self.ss.clone();
+        let ridge = 1e-10 * (a.trace() / p as f64).max(1e-300);
+        for i in 0..p {
+            a[(i, i)] += ridge;
+        }
+        let beta = a
+            .cholesky()
+            .map(|c| c.solve(&self.se))
+            .unwrap_or_else(|| DVector::zeros(p));
+        let s = self.sse(&beta);
+        (beta, s)
+    }
+}
+
+/// Step of the finite-difference sensitivities (effects are affine in their gains apart from
+/// the integrated heading, which is not used here).
+const FD_STEP: f64 = 1e-3;
+
+fn quad_of(model: &Model, cand: &Effect, rec: &Record, x0: &[f64], h: usize) -> Quad {
+    let m0 = model.clone().with_effect(*cand);
+    let e0 = errors(&m0, rec, x0, h);
+    let p = cand.gains().len();
+    let mut cols = Vec::with_capacity(p);
+    for j in 0..p {
+        let mut g = vec![0.0; p];
+        g[j] = FD_STEP;
+        let mut c = *cand;
+        c.set_gains(&g);
+        let ej = errors(&model.clone().with_effect(c), rec, x0, h);
+        cols.push(
+            e0.iter()
+                .zip(&ej)
+                .map(|(a, b)| (a - b) / FD_STEP)
+                .collect::<Vec<f64>>(),
+        );
+    }
+    let mut q = Quad::zero(p);
+    q.n = e0.len();
+    for (t, e) in e0.iter().enumerate() {
+        if !e.is_finite() {
+            q.ee = f64::INFINITY;
+            continue;
+        }
+        q.ee += e * e;
+        for i in 0..p {
+            q.se[i] += cols[i][t] * e;
+            for j in 0..=i {
+                q.ss[(i, j)] += cols[i][t] * cols[j][t];
+            }
+        }
+    }
+    for i in 0..p {
+        for j in 0..i {
+            q.ss[(j, i)] = q.ss[(i, j)];
+        }
+    }
+    q
+}
+
+/// The candidates (grid) of one effect kind, with zero gains.
+fn grid(kind: EffectKind, ts: f64, u_max: f64, du_max: f64) -> Vec<Effect> {
+    match kind {
+        EffectKind::DeadTime => {
+            let dmax = ((8.0 / ts).ceil() as usize).clamp(1, 20);
+            (1..=dmax)
+                .map(|d| Effect::DeadTime { samples: d })
+                .collect()
+        }
+        EffectKind::RateLimit => {
+            // slew rates that bind on the recorded commands: from 0.5 °/s to the largest
+            // command step, geometric
+            let hi = (du_max / ts).max(1.0);
+            let lo = 0.5_f64.min(hi / 2.0);
+            geometric(lo, hi * 0.9, 12)
+                .into_iter()
+                .map(|rate| Effect::RateLimit { rate })
+                .collect()
+        }
+        EffectKind::Saturation => geometric(0.2 * u_max, 0.95 * u_max, 12)
+            .into_iter()
+            .map(|limit| Effect::Saturation { limit })
+            .collect(),
+        EffectKind::NonlinearDamping => vec![
+            Effect::NonlinearDamping {
+                beta: 0.0,
+                cubic: false,
+            },
+            Effect::NonlinearDamping {
+                beta: 0.0,
+                cubic: true,
+            },
+        ],
+        k => vec![Effect::zero(k, 0.0)],
+    }
+}
+
+fn geometric(lo: f64, hi: f64, n: usize) -> Vec<f64> {
+    if !(lo > 0.0 && hi > lo) {
+        return vec![hi.max(1e-6)];
+    }
+    let r = (hi / lo).powf(1.0 / (n - 1) as f64);
+    (0..n).map(|i| lo * r.powi(i as i32)).collect()
+}
+
+/// A set of records with the base model's x̂(0) per record.
+struct Set<'a> {
+    recs: Vec<&'a Record>,
+    x0: Vec<Vec<f64>>,
+}
+
+impl<'a> Set<'a> {
+    fn new(model: &Model, recs: &'a [Record]) -> Set<'a> {
+        Set {
+            recs: recs.iter().collect(),
+            x0: recs
+                .iter()
+                .map(|r| predict::estimate_x0(model, r))
+                .collect(),
+        }
+    }
+
+    fn from_owned(model: &Model, recs: &'a [Record]) -> Set<'a> {
+        Set::new(model, recs)
+    }
+
+    /// Quads of every candidate, summed over records.
+    fn family(&self, model: &Model, cands: &[Effect], h: usize, parallel: bool) -> Vec<Quad> {
+        let one = |c: &Effect| {
+            let mut q = Quad::zero(c.gains().len());
+            for (r, x0) in self.recs.iter().zip(&self.x0) {
+                q.add(&quad_of(model, c, r, x0, h));
+            }
+            q
+        };
+        if parallel {
+            cands.par_iter().map(one).collect()
+        } else {
+            cands.iter().map(one).collect()
+        }
+    }
+
+    /// SSE of the base model at horizon h.
+    fn sse0(&self, model: &Model, h: usize) -> (f64, usize) {
+        let mut s = 0.0;
+        let mut n = 0;
+        for (r, x0) in self.recs.iter().zip(&self.x0) {
+            let e = errors(model, r, x0, h);
+            s += e.iter().map(|v| v * v).sum::<f64>();
+            n += e.len();
+        }
+        (s, n)
+    }
+}
+
+/// The version of an effect a record set shows: `None` (the base model) or a candidate index
+/// with its gains.
+#[derive(Debug, Clone)]
+struct Version {
+    idx: Option<usize>,
+    beta: DVector<f64>,
+}
+
+/// Best candidate of a family: (index, gains, SSE).
+fn best_of(quads: &[Quad]) -> (usize, DVector<f64>, f64) {
+    let mut best = (0, DVector::zeros(0), f64::INFINITY);
+    for (i, q) in quads.iter().enumerate() {
+        let (b, s) = q.best();
+        if s < best.2 {
+            best = (i, b, s);
+        }
+    }
+    best
+}
+
+/// The version a set shows: the best candidate when it beats the base model.
+fn version_of(quads: &[Quad], sse0: f64) -> Version {
+    let (i, b, s) = best_of(quads);
+    if s < sse0 {
+        Version {
+            idx: Some(i),
+            beta: b,
+        }
+    } else {
+        Version {
+            idx: None,
+            beta: DVector::zeros(0),
+        }
+    }
+}
+
+fn sse_at(quads: &[Quad], sse0: f64, v: &Version) -> f64 {
+    match v.idx {
+        None => sse0,
+        Some(i) => quads[i].sse(&v.beta),
+    }
+}
+
+/// `D = N·ln(SSE(reference version)/SSE(best))` on a trial set, with the best candidate.
+fn trial_statistic(
+    quads: &[Quad],
+    sse0: f64,
+    n: usize,
+    reference: &Version,
+) -> (f64, usize, DVector<f64>) {
+    let base = sse_at(quads, sse0, reference);
+    let (i, b, s) = best_of(quads);
+    let s = s.min(base);
+    let d = n as f64 * (base / s).ln();
+    (d.max(0.0), i, b)
+}
+
+/// The candidate with its gains set.
+fn effect_with(cand: &Effect, beta: &DVector<f64>) -> Effect {
+    let mut e = *cand;
+    if !beta.is_empty() {
+        e.set_gains(beta.as_slice());
+    }
+    e
+}
+
+// ---------------------------------------------------------------------------------------
+// parametric bootstrap
+
+/// Standard normal by Box–Muller.
+fn gauss(rng: &mut ChaCha8Rng) -> f64 {
+    let u1: f64 = 1.0 - rng.random::<f64>();
+    let u2: f64 = rng.random::<f64>();
+    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+}
+
+/// Simulates the innovations model on the commands of `like` with innovation std `sigma`
+/// (heading integrated from the simulated rate, from the record's first heading).
+fn simulate_innovations(model: &Model, like: &Record, sigma: f64, rng: &mut ChaCha8Rng) -> Record {
+    let s = Stepper::new(model);
+    let p0 = like.psi.as_ref().map(|p| p[0]).unwrap_or(0.0);
+    let mut st = s.initial(&[], p0);
+    let n = like.len();
+    let mut y = Vec::with_capacity(n);
+    let mut psi = Vec::with_capacity(n);
+    let mut p = p0;
+    for t in 0..n {
+        let yt = s.output(&st) + sigma * gauss(rng);
+        psi.push(p);
+        s.step(&mut st, like.u[t], yt, Some(p));
+        p += model.ts * (yt - s.d_y());
+        y.push(yt);
+    }
+    let mut r = Record::from_uy(&like.name, like.ts, like.u.clone(), y);
+    r.psi = Some(psi);
+    r
+}
+
+/// A scaled χ² `c·χ²_ν` fitted to replicates by their mean and variance (Satterthwaite).
+#[derive(Debug, Clone, Copy)]
+struct Null {
+    c: f64,
+    nu: f64,
+}
+
+impl Null {
+    fn fit(reps: &[f64]) -> Null {
+        let n = reps.len().max(1) as f64;
+        let mean = reps.iter().sum::<f64>() / n;
+        let var = reps.iter().map(|r| (r - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+        let mean = mean.max(1e-9);
+        let var = var.max(1e-12 * mean * mean);
+        Null {
+            c: var / (2.0 * mean),
+            nu: (2.0 * mean * mean / var).max(0.05),
+        }
+    }
+
+    fn p(&self, d: f64) -> f64 {
+        chi2_sf(d / self.c, self.nu).clamp(0.0, 1.0)
+    }
+
+    /// Likelihood gain above what noise alone gives (`D` minus the null's mean): comparable
+    /// across effects judged on the same errors, where far-tail p-values are not.
+    fn excess(&self, d: f64) -> f64 {
+        d - self.c * self.nu
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// channel statistics
+
+/// Gyro-bias estimate from heading: `mean((r(t)+r(t+1))/2 − Δψ/Ts)` with its standard error
+/// from block sums. `None` without heading.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeadingBias {
+    /// Estimated rate-sensor offset (deg/s).
+    pub bias: f64,
+    /// Its standard error (deg/s).
+    pub se: f64,
+    /// Samples used.
+    pub n: usize,
+}
+
+/// Rate-sensor offset seen by the heading channel over `recs` (pooled), or `None` when a
+/// record has no heading.
+///
+/// ```
+/// use yawcast::{data::Record, diagnose::heading_bias};
+/// // heading turns at 1 °/s, the gyro reads 1.2 °/s
+/// let mut r = Record::from_uy("x", 1.0, vec![0.0; 400], vec![1.2; 400]);
+/// r.psi = Some((0..400).map(|i| i as f64).collect());
+/// let hb = heading_bias(&[r]).unwrap();
+/// assert!((hb.bias - 0.2).abs() < 1e-12);
+/// ```
+pub fn heading_bias(recs: &[Record]) -> Option<HeadingBias> {
+    let mut sum = 0.0;
+    let mut n = 0usize;
+    let mut blocks: Vec<f64> = Vec::new();
+    for r in recs {
+        let psi = r.psi.as_ref()?;
+        if r.len() < 3 {
+            continue;
+        }
+        let m = r.len() - 1;
+        let l = block_len(m);
+        let mut acc = 0.0;
+        let mut cnt = 0;
+        for t in 0..m {
+            let d = 0.5 * (r.y[t] + r.y[t + 1]) - (psi[t + 1] - psi[t]) / r.ts;
+            sum += d;
+            n += 1;
+            acc += d;
+            cnt += 1;
+            if cnt == l {
+                blocks.push(acc);
+                acc = 0.0;
+                cnt = 0;
+            }
+        }
+        if cnt > 0 {
+            blocks.push(acc * l as f64 / cnt as f64);
+        }
+    }
+    if n == 0 {
+        return None;
+    }
+    let mean = sum / n as f64;
+    let l = (n as f64 / blocks.len().max(1) as f64).max(1.0);
+    let var: f64 = blocks.iter().map(|b| (b - mean * l).powi(2)).sum::<f64>();
+    let se = (var.max(0.0)).sqrt() / n as f64;
+    Some(HeadingBias {
+        bias: mean,
+        se: se.max(1e-12),
+        n,
+    })
+}
+
+fn block_len(n: usize) -> usize {
+    ((n as f64).sqrt().round() as usize).clamp(10, 200)
+}
+
+/// Coefficients of (sin ψ, cos ψ, sin 2ψ, cos 2ψ) in speed over ground; nuisance: one
+/// intercept per record and low-passed r² and δ² (speed lost in turns and to pod drag).
+/// `shift[i]` circularly shifts record i's heading against its speed (0: aligned).
+fn sog_harmonics(recs: &[Record], shift: &[usize]) -> Option<DVector<f64>> {
+    sog_fit(recs, shift, 0.0).map(|(b, _)| b)
+}
+
+/// The harmonic regression with the heading harmonics low-passed with time constant `lag_s`
+/// (0: instantaneous): (harmonic coefficients, residual sum of squares).
+fn sog_fit(recs: &[Record], shift: &[usize], lag_s: f64) -> Option<(DVector<f64>, f64)> {
+    let nr = recs.len();
+    let p = nr + 6;
+    let mut xtx = DMatrix::<f64>::zeros(p, p);
+    let mut xty = DVector::<f64>::zeros(p);
+    let mut yy = 0.0;
+    let mut x = DVector::<f64>::zeros(p);
+    for (i, r) in recs.iter().enumerate() {
+        let psi = r.psi.as_ref()?;
+        let sp = r.speed.as_ref()?;
+        let a = (r.ts / SOG_TAU_S).min(1.0);
+        let al = if lag_s > 0.0 {
+            (r.ts / lag_s).min(1.0)
+        } else {
+            1.0
+        };
+        let (mut lr, mut lu) = (0.0, 0.0);
+        let n = r.len();
+        let sh = shift.get(i).copied().unwrap_or(0) % n.max(1);
+        let mut hf = [0.0; 4];
+        for t in 0..n {
+            lr += a * (r.y[t] * r.y[t] - lr);
+            lu += a * (r.u[t] * r.u[t] - lu);
+            let ph = psi[(t + sh) % n].to_radians();
+            let h = [ph.sin(), ph.cos(), (2.0 * ph).sin(), (2.0 * ph).cos()];
+            for j in 0..4 {
+                hf[j] = if t == 0 {
+                    h[j]
+                } else {
+                    hf[j] + al * (h[j] - hf[j])
+                };
+            }
+            x.fill(0.0);
+            x[i] = 1.0;
+            for j in 0..4 {
+                x[nr + j] = hf[j];
+            }
+            x[nr + 4] = lr;
+            x[nr + 5] = lu;
+            xtx.ger(1.0, &x, &x, 1.0);
+            xty.axpy(sp[t], &x, 1.0);
+            yy += sp[t] * sp[t];
+        }
+    }
+    let beta = xtx.cholesky()?.solve(&xty);
+    let rss = (yy - beta.dot(&xty)).max(0.0);
+    Some((beta.rows(nr, 4).into_owned(), rss))
+}
+
+/// Lags (s) tried for the response of speed over ground to heading: 0 is the kinematic
+/// response of a current (the water carries the ship at once), the others the dynamic
+/// response of the surge motion to a force (wind).
+const SOG_LAGS_S: [f64; 6] = [0.0, 5.0, 10.0, 20.0, 40.0, 80.0];
+
+/// The lag (s) of [`SOG_LAGS_S`] with which heading harmonics explain speed over ground best
+/// (equal parameter counts, so the smallest residual wins).
+fn sog_best_lag(recs: &[Record]) -> Option<f64> {
+    let mut best = (f64::INFINITY, 0.0);
+    for &l in &SOG_LAGS_S {
+        let (_, rss) = sog_fit(recs, &[], l)?;
+        if rss < best.0 {
+            best = (rss, l);
+        }
+    }
+    Some(best.1)
+}
+
+/// Time constant of the low-pass nuisance regressors of speed over ground (s).
+const SOG_TAU_S: f64 = 20.0;
+/// Circular shifts drawn for the null covariance of the speed harmonics.
+const SOG_SHIFTS: usize = 60;
+
+/// Covariance of the harmonics under "no heading dependence": heading circularly shifted
+/// against speed by random amounts (10–90 % of each record), which keeps both series'
+/// own structure.
+fn sog_null_cov(recs: &[Record], rng: &mut ChaCha8Rng) -> Option<DMatrix<f64>> {
+    let mut draws = Vec::with_capacity(SOG_SHIFTS);
+    for _ in 0..SOG_SHIFTS {
+        let sh: Vec<usize> = recs
+            .iter()
+            .map(|r| {
+                let n = r.len();
+                rng.random_range(n / 10..=(9 * n / 10).max(n / 10 + 1))
+            })
+            .collect();
+        draws.push(sog_harmonics(recs, &sh)?);
+    }
+    let m = draws.len() as f64;
+    let mean = draws.iter().fold(DVector::zeros(4), |a, b| a + b) / m;
+    let mut cov = DMatrix::<f64>::zeros(4, 4);
+    for d in &draws {
+        let c = d - &mean;
+        cov += &c * c.transpose();
+    }
+    Some(cov / (m - 1.0))
+}
+
+/// Wald χ² of `d` (subset `idx`) with covariance `v`.
+fn wald(d: &DVector<f64>, v: &DMatrix<f64>, idx: &[usize]) -> f64 {
+    let k = idx.len();
+    let dd = DVector::from_iterator(k, idx.iter().map(|&i| d[i]));
+    let vv = DMatrix::from_fn(k, k, |a, b| v[(idx[a], idx[b])]);
+    match vv.try_inverse() {
+        Some(inv) => dd.dot(&(inv * &dd)).max(0.0),
+        None => 0.0,
+    }
+}
+
+/// SOG evidence: (χ² first harmonic, χ² second harmonic, first-harmonic amplitude m/s,
+/// direction deg the speed gain points to).
+#[derive(Debug, Clone, Copy)]
+struct SogEvidence {
+    lag_s: f64,
+    chi1: f64,
+    chi2: f64,
+    amp1: f64,
+    dir1: f64,
+    amp2: f64,
+}
+
+fn sog_evidence(trial: &[Record], reference: &[Record], seed: u64) -> Option<SogEvidence> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5047_5f53_4f47);
+    let t = sog_harmonics(trial, &[])?;
+    let vt = sog_null_cov(trial, &mut rng)?;
+    let (d, v) = if reference.is_empty() {
+        (t, vt)
+    } else {
+        let r = sog_harmonics(reference, &[])?;
+        let vr = sog_null_cov(reference, &mut rng)?;
+        (t - r, vt + vr)
+    };
+    Some(SogEvidence {
+        lag_s: sog_best_lag(trial)?,
+        chi1: wald(&d, &v, &[0, 1]),
+        chi2: wald(&d, &v, &[2, 3]),
+        amp1: d[0].hypot(d[1]),
+        dir1: d[0].atan2(d[1]).to_degrees().rem_euclid(360.0),
+        amp2: d[2].hypot(d[3]),
+    })
+}
+
+/// Number of effects tested (Bonferroni: each is judged at α / m).
+fn cfg_m(_cfg: &DiagnoseConfig) -> f64 {
+    EffectKind::ALL.len() as f64
+}
+
+// ---------------------------------------------------------------------------------------
+// the diagnosis
+
+/// Everything computed for one effect kind.
+#[derive(Debug, Clone)]
+struct Evidence {
+    kind: EffectKind,
+    h: usize,
+    null: Null,
+    best: Effect,
+    p: f64,
+    score: f64,
+    statistic: f64,
+    words: String,
+    parameter: Option<f64>,
+    channel_material: bool,
+}
+
+/// Diagnoses which library effect `model` is missing on the trial records `est`.
+///
+/// `reference` holds the records the model was identified from (may be empty: the verdict is
+/// then weaker, and the explanation says so); `val` holds held-out trial records for the
+/// materiality check (empty: the last 30 % of each trial record are held out).
+///
+/// # Errors
+/// [`DiagnoseError::Input`] for an invalid model, no trial records, records whose sample time
+/// differs from the model's, ragged or non-finite channels, or records shorter than
+/// [`MIN_SAMPLES`]; [`DiagnoseError::Mismatch`] when the records lack a channel some of the
+/// others have in a way that makes the comparison meaningless.
+///
+/// ```
+/// use yawcast::{data::Record, diagnose::{diagnose, DiagnoseConfig}, model::Model};
+/// let m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.3, 0.1]).unwrap();
+/// let e = diagnose(&m, &[], &[], &[], &DiagnoseConfig::default()).unwrap_err();
+/// assert_eq!(e.to_string(), "no trial records given");
+/// ```
+pub fn diagnose(
+    model: &Model,
+    reference: &[Record],
+    est: &[Record],
+    val: &[Record],
+    cfg: &DiagnoseConfig,
+) -> Result<Diagnosis, DiagnoseError> {
+    check_inputs(model, est, MIN_SAMPLES, "trial")?;
+    if !reference.is_empty() {
+        check_inputs(model, reference, MIN_SAMPLES, "reference")?;
+    }
+    if !val.is_empty() {
+        check_inputs(model, val, 4 * model.n + 4, "validation")?;
+    }
+    if !(cfg.alpha > 0.0 && cfg.alpha < 1.0) {
+        return Err(InputError::Config(format!("alpha {} is not in (0, 1)", cfg.alpha)).into());
+    }
+    let reps = cfg.null_reps.max(8);
+    let has_ref = !reference.is_empty();
+    let trial = Set::new(model, est);
+    let refset = Set::from_owned(model, reference);
+    let all = est.iter().chain(reference);
+    let u_max = all
+        .clone()
+        .flat_map(|r| r.u.iter())
+        .fold(0.0_f64, |a, b| a.max(b.abs()));
+    let du_max = all
+        .flat_map(|r| r.u.windows(2).map(|w| (w[1] - w[0]).abs()))
+        .fold(0.0_f64, f64::max);
+    // innovation std under the null: the model's one-step errors on the reference (or trial)
+    let sig_set = if has_ref { &refset } else { &trial };
+    let (s1, n1) = sig_set.sse0(model, 1);
+    let sigma = (s1 / n1.max(1) as f64).sqrt();
+
+    let kinds: Vec<EffectKind> = EffectKind::ALL
+        .iter()
+        .copied()
+        .filter(|k| model.effect(*k).is_none())
+        .filter(|k| !(*k == EffectKind::Saturation && u_max <= 0.0))
+        .collect();
+
+    let heading_ok = est.iter().all(|r| r.psi.is_some())
+        && (!has_ref || reference.iter().all(|r| r.psi.is_some()));
+    let speed_ok = heading_ok
+        && est.iter().all(|r| r.speed.is_some())
+        && (!has_ref || reference.iter().all(|r| r.speed.is_some()));
+    let hb = if heading_ok {
+        let t = heading_bias(est);
+        let r = if has_ref {
+            heading_bias(reference)
+        } else {
+            None
+        };
+        t.map(|t| match r {
+            Some(r) => (t.bias - r.bias, t.se.hypot(r.se)),
+            None => (t.bias, t.se),
+        })
+    } else {
+        None
+    };
+    let sog = if speed_ok {
+        sog_evidence(est, if has_ref { reference } else { &[] }, cfg.seed)
+    } else {
+        None
+    };
+
+    let grids: Vec<(EffectKind, Vec<Effect>)> = kinds
+        .iter()
+        .map(|&k| (k, grid(k, model.ts, u_max, du_max)))
+        .collect();
+    let real = world(model, reference, est, &grids, cfg.parallel);
+    let nulls = bootstrap(
+        model,
+        reference,
+        est,
+        &grids,
+        sigma,
+        reps,
+        cfg.seed,
+        cfg.parallel,
+    );
+    let evidence: Vec<Evidence> = kinds
+        .iter()
+        .enumerate()
+        .map(|(i, &kind)| effect_evidence(model, kind, &real[i], &nulls[i], has_ref, cfg, hb, sog))
+        .collect();
+    let mut ev = evidence;
+    let level = cfg.alpha / cfg_m(cfg);
+    ev.sort_by(|a, b| {
+        let key = |e: &Evidence| ((e.p < level) as u8, e.channel_material as u8);
+        key(b).cmp(&key(a)).then(
+            b.score
+                .partial_cmp(&a.score)
+                .unwrap_or(std::cmp::Ordering::Equal),
+        )
+    });
+    encompass(model, &trial, &mut ev, level, cfg.alpha, cfg.parallel, sog);
+
+    // materiality: the effect's own held-out contribution (θ frozen, the effect's gains
+    // refitted on the estimation part), best first; the verdict's effect is then refitted
+    // with the model (augment) for the before/after fits
+    let (est_part, held_out): (Vec<Record>, Vec<Record>) = if val.is_empty() {
+        split(est)
+    } else {
+        (est.to_vec(), val.to_vec())
+    };
+    let before = mean_fit(model, &held_out, &Horizon::REPORT);
+    let est_set = Set::new(model, &est_part);
+    let mut ranking = Vec::new();
+    let mut verdict: Option<(usize, BTreeMap<String, f64>)> = None;
+    for (i, e) in ev.iter().enumerate() {
+        let significant = e.p < level;
+        let mut fit_gain = 0.0;
+        let mut material = significant && e.channel_material;
+        if significant {
+            let (gain, fits) = frozen_gain(model, e, &est_set, &held_out, &before, cfg.parallel);
+            fit_gain = gain;
+            material |= gain > 0.0;
+            if material && verdict.is_none() {
+                verdict = Some((i, fits));
+            }
+        }
+        ranking.push(Ranked {
+            effect: e.kind.name().into(),
+            statistic: e.statistic,
+            p_value: e.p,
+            fit_gain_pp: fit_gain,
+            significant,
+            material,
+            parameter: e.parameter,
+            evidence: e.words.clone(),
+        });
+    }
+    let verdict = verdict.map(|(i, frozen_fits)| {
+        let report = if cfg.confirm {
+            crate::augment::augment(model, ev[i].kind, &est_part, &held_out, &cfg.augment).ok()
+        } else {
+            None
+        };
+        let after = match &report {
+            Some(r) => mean_fit(&r.candidate, &held_out, &Horizon::REPORT),
+            None => frozen_fits,
+        };
+        (i, after, report)
+    });
+    let (verdict_name, explanation, after, augment) = match verdict {
+        Some((i, after, aug)) => {
+            let e = &ev[i];
+            let r = &ranking[i];
+            let mut s = format!(
+                "The trials show {} that the {} lacks: {} (p = {:.2e}, held-out fit gain {:+.1} pp).",
+                describe(e.kind),
+                if has_ref { "reference" } else { "model" },
+                e.words,
+                r.p_value,
+                r.fit_gain_pp
+            );
+            if let Some(second) = ranking
+                .iter()
+                .enumerate()
+                .find(|(j, x)| *j != i && x.significant)
+            {
+                s.push_str(&format!(
+                    " Runner-up: {} (p = {:.2e}), explained by it.",
+                    second.1.effect, second.1.p_value
+                ));
+            }
+            if let Some(a) = &aug {
+                s.push_str(&format!(" Refitted with the model: {}", a.explanation));
+            }
+            (e.kind.name().to_string(), s, after, aug)
+        }
+        None => {
+            let sig: Vec<&Ranked> = ranking.iter().filter(|r| r.significant).collect();
+            let s = if sig.is_empty() {
+                format!(
+                    "No effect of the library is significant at α = {} against its null \
+                     distribution: the trials show nothing the {} lacks.",
+                    cfg.alpha,
+                    if has_ref { "reference" } else { "model" }
+                )
+            } else {
+                format!(
+                    "{} significant but not material: refitted, {} not improve held-out \
+                     prediction, so the model is kept without it.",
+                    sig.iter()
+                        .map(|r| r.effect.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    if sig.len() == 1 { "it does" } else { "they do" }
+                )
+            };
+            ("none".to_string(), s, before.clone(), None)
+        }
+    };
+    let mut explanation = explanation;
+    if !has_ref {
+        explanation.push_str(
+            " No reference records were given, so every statistic is judged against the \
+             model alone: hull nonlinearity the model never had shows up as an effect, and the \
+             verdict is weaker.",
+        );
+    }
+    if !heading_ok {
+        explanation.push_str(
+            " Heading is not logged in every record: a gyro bias cannot be told apart from a \
+             constant yaw moment (bias).",
+        );
+    }
+    if !speed_ok {
+        explanation.push_str(
+            " Speed over ground (or heading) is not logged in every record: current and wind \
+             are judged from the yaw rate alone and are hard to tell apart from a bias.",
+        );
+    }
+    Ok(Diagnosis {
+        verdict: verdict_name,
+        ranking,
+        explanation,
+        reference_used: has_ref,
+        augment,
+        before,
+        after,
+    })
+}
+
+/// Hold-out split: the last 30 % of each record (kept long enough for the slow horizon).
+fn split(est: &[Record]) -> (Vec<Record>, Vec<Record>) {
+    let mut a = Vec::new();
+    let mut b = Vec::new();
+    for r in est {
+        let n = r.len();
+        let cut = (n * 7 / 10).max(n.saturating_sub(n / 3));
+        a.push(r.slice(0, cut));
+        b.push(r.slice(cut, n));
+    }
+    (a, b)
+}
+
+fn describe(kind: EffectKind) -> &'static str {
+    match kind {
+        EffectKind::Bias => "a constant yaw moment",
+        EffectKind::GyroBias => "a rate-gyro offset",
+        EffectKind::DeadTime => "a command dead time",
+        EffectKind::RateLimit => "a pod slew-rate limit",
+        EffectKind::Saturation => "a pod angle limit",
+        EffectKind::Asymmetry => "a port/starboard steering asymmetry",
+        EffectKind::NonlinearDamping => "extra nonlinear yaw damping",
+        EffectKind::Wind => "a heading-dependent wind moment",
+        EffectKind::Current => "a current",
+        _ => "an effect",
+    }
+}
+
+/// What one "world" (a model, its reference records, trial records) shows for one effect.
+#[derive(Debug, Clone)]
+struct WorldStat {
+    d: f64,
+    best: Effect,
+    n: usize,
+}
+
+/// The statistic `D` of every kind in one world: the reference version of each effect is
+/// fitted on `reference` (none when empty), `D` measured on `trial`.
+fn world(
+    model: &Model,
+    reference: &[Record],
+    trial: &[Record],
+    grids: &[(EffectKind, Vec<Effect>)],
+    parallel: bool,
+) -> Vec<WorldStat> {
+    let tset = Set::new(model, trial);
+    let rset = Set::new(model, reference);
+    let one = |(kind, cands): &(EffectKind, Vec<Effect>)| {
+        let h = horizon_of(*kind);
+        let (t0, tn) = tset.sse0(model, h);
+        let tq = tset.family(model, cands, h, false);
+        let version = if reference.is_empty() {
+            Version {
+                idx: None,
+                beta: DVector::zeros(0),
+            }
+        } else {
+            let (r0, _) = rset.sse0(model, h);
+            let rq = rset.family(model, cands, h, false);
+            version_of(&rq, r0)
+        };
+        let (d, bi, bb) = trial_statistic(&tq, t0, tn, &version);
+        WorldStat {
+            d,
+            best: effect_with(&cands[bi], &bb),
+            n: tn,
+        }
+    };
+    if parallel {
+        grids.par_iter().map(one).collect()
+    } else {
+        grids.iter().map(one).collect()
+    }
+}
+
+/// Null replicates of `D` for every kind: parametric bootstrap of the whole procedure. The
+/// innovations model is simulated with its innovation std on the recorded inputs of the
+/// reference and trial records, the model is re-identified on the simulated reference (on the
+/// simulated trials when there is no reference), and `D` is recomputed.
+#[allow(clippy::too_many_arguments)]
+fn bootstrap(
+    model: &Model,
+    reference: &[Record],
+    est: &[Record],
+    grids: &[(EffectKind, Vec<Effect>)],
+    sigma: f64,
+    reps: usize,
+    seed: u64,
+    parallel: bool,
+) -> Vec<Vec<f64>> {
+    let one = |r: usize| -> Vec<f64> {
+        let mut rng = ChaCha8Rng::seed_from_u64(
+            seed.wrapping_mul(0x9E37_79B9_7F4A_7C15)
+                .wrapping_add(r as u64),
+        );
+        let rs: Vec<Record> = reference
+            .iter()
+            .map(|rec| simulate_innovations(model, rec, sigma, &mut rng))
+            .collect();
+        let ts: Vec<Record> = est
+            .iter()
+            .map(|rec| simulate_innovations(model, rec, sigma, &mut rng))
+            .collect();
+        let pc = PemConfig {
+            order: model.n,
+            max_iter: 30,
+            parallel: false,
+            ..PemConfig::default()
+        };
+        let fit_on = if rs.is_empty() { &ts } else { &rs };
+        let m = pem::identify_from(fit_on, model, &pc)
+            .map(|r| r.model)
+            .unwrap_or_else(|_| model.clone());
+        world(&m, &rs, &ts, grids, false)
+            .into_iter()
+            .map(|w| w.d)
+            .collect()
+    };
+    let per: Vec<Vec<f64>> = if parallel {
+        (0..reps).into_par_iter().map(one).collect()
+    } else {
+        (0..reps).map(one).collect()
+    };
+    (0..grids.len())
+        .map(|k| per.iter().map(|v| v[k]).collect())
+        .collect()
+}
+
+#[allow(clippy::too_many_arguments)]
+fn effect_evidence(
+    model: &Model,
+    kind: EffectKind,
+    stat: &WorldStat,
+    null_reps: &[f64],
+    has_ref: bool,
+    cfg: &DiagnoseConfig,
+    hb: Option<(f64, f64)>,
+    sog: Option<SogEvidence>,
+) -> Evidence {
+    let ts = model.ts;
+    let h = horizon_of(kind);
+    let d = stat.d;
+    let tn = stat.n;
+    let best = stat.best;
+    let null = Null::fit(null_reps);
+    let p_yaw = null.p(d);
+    let mut ev = Evidence {
+        kind,
+        h,
+        null,
+        best,
+        p: p_yaw,
+        score: null.excess(d),
+        statistic: d,
+        words: String::new(),
+        parameter: None,
+        channel_material: false,
+    };
+    let pct = 100.0 * (1.0 - (-d / tn.max(1) as f64).exp());
+    match best {
+        Effect::DeadTime { samples } => {
+            let s = samples as f64 * ts;
+            ev.parameter = Some(s);
+            ev.words = format!(
+                "errors follow the pod commands late; a dead time of {s:.1} s removes {pct:.0} % of \
+                 the one-step error energy the reference version leaves"
+            );
+        }
+        Effect::RateLimit { rate } => {
+            ev.parameter = Some(rate);
+            ev.words = format!(
+                "errors grow right after fast pod reversals; a slew limit of {rate:.1} °/s explains \
+                 {pct:.0} % of the one-step error energy"
+            );
+        }
+        Effect::Saturation { limit } => {
+            ev.parameter = Some(limit);
+            ev.words = format!(
+                "large pod angles turn the ship less than the model expects; an angle limit of \
+                 {limit:.1}° explains {pct:.0} % of the one-step error energy"
+            );
+        }
+        Effect::Asymmetry { beta } => {
+            ev.parameter = Some(beta);
+            ev.words = format!(
+                "starboard commands act {} than port ones (gain {beta:+.3} on max(δ,0)); explains \
+                 {pct:.0} % of the one-step error energy",
+                if beta > 0.0 { "harder" } else { "softer" }
+            );
+        }
+        Effect::NonlinearDamping { beta, cubic } => {
+            ev.parameter = Some(beta);
+            ev.words = format!(
+                "fast turns are damped {} than the model expects ({} gain {beta:+.4}); explains \
+                 {pct:.0} % of the one-step error energy",
+                if beta < 0.0 { "more" } else { "less" },
+                if cubic { "r³" } else { "r|r|" }
+            );
+        }
+        Effect::Bias { beta } => {
+            ev.parameter = Some(beta);
+            ev.words = format!(
+                "a steady yaw moment worth {beta:+.2}° of pod angle; explains {pct:.0} % of the \
+                 {SLOW_HORIZON}-step error energy"
+            );
+        }
+        Effect::GyroBias { d_y } => {
+            ev.parameter = Some(d_y);
+            ev.words = format!(
+                "the yaw rate reads {d_y:+.3} °/s off on the {SLOW_HORIZON}-step errors ({pct:.0} % of their energy)"
+            );
+        }
+        Effect::Wind { .. } => {
+            ev.words = format!(
+                "the yaw moment varies with heading (1st and 2nd harmonics); explains {pct:.0} % \
+                 of the {SLOW_HORIZON}-step error energy"
+            );
+        }
+        Effect::Current { .. } => {
+            ev.words = format!(
+                "the yaw moment varies with heading (1st harmonic); explains {pct:.0} % of the \
+                 {SLOW_HORIZON}-step error energy"
+            );
+        }
+    }
+    // channels
+    match kind {
+        EffectKind::GyroBias => {
+            if let Some((b, se)) = hb {
+                let z = b / se;
+                ev.p = (2.0 * normal_sf(z.abs())).min(1.0);
+                ev.statistic = z * z;
+                ev.score = z * z - 1.0;
+                ev.parameter = Some(b);
+                ev.channel_material = true;
+                ev.words = format!(
+                    "the gyro reads {b:+.3} ± {se:.3} °/s more than the heading turns \
+                     (mean r − mean dψ/dt{})",
+                    if has_ref {
+                        ", trial minus reference"
+                    } else {
+                        ""
+                    }
+                );
+            }
+        }
+        EffectKind::Current | EffectKind::Wind => {
+            if let Some(s) = sog {
+                let (chi, df) = if kind == EffectKind::Current {
+                    (s.chi1, 2.0)
+                } else {
+                    (s.chi1 + s.chi2, 4.0)
+                };
+                let p_sog = chi2_sf(chi, df);
+                // either channel may show it (Bonferroni over the two)
+                ev.p = (2.0 * p_yaw.min(p_sog)).min(1.0);
+                ev.score = ev.score.max(chi - df);
+                ev.channel_material = p_sog < cfg.alpha / cfg_m(cfg);
+                if kind == EffectKind::Current {
+                    ev.parameter = Some(s.amp1);
+                    ev.words.push_str(&format!(
+                        "; speed over ground varies by ±{:.3} m/s with heading, fastest heading \
+                         {:.0}° (χ² = {chi:.1}, 2 df)",
+                        s.amp1, s.dir1
+                    ));
+                } else {
+                    ev.words.push_str(&format!(
+                        "; speed over ground varies with heading by ±{:.3} m/s (1st harmonic) and \
+                         ±{:.3} m/s (2nd) (χ² = {chi:.1}, 4 df)",
+                        s.amp1, s.amp2
+                    ));
+                }
+            }
+        }
+        _ => {}
+    }
+    ev
+}
+
+/// Encompassing test between the top two significant effects of the same horizon class:
+/// both fitted jointly; what does each add given the other? The one that adds nothing
+/// significant given the other is explained by it (and, when neither adds anything, the
+/// simpler one is kept). An effect shown by its own channel is not displaced by one that is not.
+fn encompass(
+    model: &Model,
+    trial: &Set<'_>,
+    ev: &mut [Evidence],
+    level: f64,
+    alpha: f64,
+    par: bool,
+    sog: Option<SogEvidence>,
+) {
+    if ev.len() < 2 || ev[1].p >= level {
+        return;
+    }
+    // current vs wind, both shown by speed over ground: a current moves the ship at once
+    // (kinematic), wind through the surge dynamics (lagged)
+    let pair = [ev[0].kind, ev[1].kind];
+    if let Some(s) = sog {
+        // speed over ground shows a heading dependence (one test at level α)
+        let shows = chi2_sf(s.chi1 + s.chi2, 4.0) < alpha;
+        if shows && pair.contains(&EffectKind::Current) && pair.contains(&EffectKind::Wind) {
+            let want = if s.lag_s == 0.0 {
+                EffectKind::Current
+            } else {
+                EffectKind::Wind
+            };
+            let w = format!(
+                "; speed over ground follows heading {} (best lag {:.0} s of {:?} s tried): {}",
+                if s.lag_s == 0.0 {
+                    "at once"
+                } else {
+                    "with a lag"
+                },
+                s.lag_s,
+                SOG_LAGS_S,
+                if s.lag_s == 0.0 {
+                    "the water carries the ship, a current"
+                } else {
+                    "a force acting through the surge dynamics, wind"
+                }
+            );
+            ev[0].words.push_str(&w);
+            ev[1].words.push_str(&w);
+            if ev[1].kind == want {
+                ev.swap(0, 1);
+            }
+            return;
+        }
+    }
+    if ev[0].channel_material != ev[1].channel_material {
+        return;
+    }
+    // on the slower horizon every effect is visible; the scale of the null comes from an
+    // effect judged on that horizon
+    let h = ev[0].h.max(ev[1].h);
+    let alone = |x: &Evidence| {
+        trial.family(model, &[zero_gains(&x.best)], h, par)[0]
+            .best()
+            .1
+    };
+    let on_top = |base: &Evidence, x: &Evidence| {
+        let m = model.clone().with_effect(base.best);
+        trial.family(&m, &[zero_gains(&x.best)], h, par)[0].best().1
+    };
+    let (a, b) = (&ev[0], &ev[1]);
+    let sa = alone(a);
+    let sb = alone(b);
+    let sab = on_top(a, b).min(on_top(b, a)).min(sa).min(sb);
+    let n = trial.sse0(model, h).1 as f64;
+    let adds_a = (n * (sb / sab).ln()).max(0.0);
+    let adds_b = (n * (sa / sab).ln()).max(0.0);
+    let scale = |x: &Evidence| {
+        if x.h == h {
+            x.null
+        } else if a.h == h {
+            a.null
+        } else {
+            b.null
+        }
+    };
+    // degrees of freedom of what one adds given the other: wind nests current (its first
+    // harmonics are current's regressors), so wind adds only its second harmonics
+    let frac = |x: &Evidence, y: &Evidence| -> f64 {
+        let (gx, gy) = (x.best.gains().len(), y.best.gains().len());
+        let nested = x.kind == EffectKind::Wind && y.kind == EffectKind::Current;
+        if nested && gx > gy {
+            (gx - gy) as f64 / gx as f64
+        } else {
+            1.0
+        }
+    };
+    let (mut na_, mut nb_) = (scale(a), scale(b));
+    na_.nu *= frac(a, b);
+    nb_.nu *= frac(b, a);
+    // one test of one pair: level α
+    let (pa, pb) = (na_.p(adds_a), nb_.p(adds_b));
+    let sig_a = pa < alpha;
+    let sig_b = pb < alpha;
+    let simpler_b = b.best.gains().len() < a.best.gains().len();
+    let (xa, xb) = (na_.excess(adds_a), nb_.excess(adds_b));
+    let swap = match (sig_a, sig_b) {
+        // b adds what a misses, a adds nothing given b
+        (false, true) => true,
+        // both add: the larger gain above noise wins
+        (true, true) => xb > xa,
+        // neither adds given the other: the simpler one
+        (false, false) => simpler_b,
+        (true, false) => false,
+    };
+    let _ = level;
+    let w = format!(
+        "; encompassing test ({h}-step errors): given {nb}, {na} still adds p = {pa:.2e}; given \
+         {na}, {nb} adds p = {pb:.2e}",
+        na = a.kind.name(),
+        nb = b.kind.name()
+    );
+    ev[0].words.push_str(&w);
+    ev[1].words.push_str(&w);
+    if swap {
+        ev.swap(0, 1);
+    }
+}
+
+fn zero_gains(e: &Effect) -> Effect {
+    let mut c = *e;
+    let g = vec![0.0; e.gains().len()];
+    c.set_gains(&g);
+    c
+}
+
+/// The effect's own held-out contribution: θ frozen, the effect's structure as found, its
+/// gains refitted on `est`; (gain pp at the effect's horizon — 10 steps for actuator and hull
+/// effects, `sim` for slow ones —, held-out fits with the effect).
+fn frozen_gain(
+    model: &Model,
+    e: &Evidence,
+    est: &Set<'_>,
+    held_out: &[Record],
+    before: &BTreeMap<String, f64>,
+    parallel: bool,
+) -> (f64, BTreeMap<String, f64>) {
+    let cand = zero_gains(&e.best);
+    let q = est.family(model, &[cand], e.h, parallel);
+    let (beta, _) = q[0].best();
+    let m = model.clone().with_effect(effect_with(&cand, &beta));
+    let fits = mean_fit(&m, held_out, &Horizon::REPORT);
+    let key = if e.h == 1 { "10" } else { "sim" };
+    let gain = match (fits.get(key), before.get(key)) {
+        (Some(a), Some(b)) if (a - b).is_finite() => a - b,
+        _ => f64::NEG_INFINITY,
+    };
+    (gain, fits)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::{simulate, NoiseSpec, Scenario, Ship, SimEffect};
+
+    fn noise() -> NoiseSpec {
+        NoiseSpec {
+            gyro_std_degps: 0.03,
+            heading_std_deg: 0.1,
+            speed_std_mps: 0.01,
+        }
+    }
+
+    fn records(kind: Option<(EffectKind, f64)>, seeds: &[u64]) -> Vec<Record> {
+        let ship = Ship::default_lng();
+        let mut sc = match kind {
+            Some((k, s)) => Scenario::with_effect(SimEffect::hidden(k, s)),
+            None => Scenario::default(),
+        };
+        sc.noise = noise();
+        seeds
+            .par_iter()
+            .map(|&s| simulate(&ship, &sc, s).unwrap())
+            .collect()
+    }
+
+    fn identify(recs: &[Record]) -> Model {
+        pem::identify(recs, None, &PemConfig::default())
+            .unwrap()
+            .model
+    }
+
+    struct Fixture {
+        refs: Vec<Vec<Record>>,
+        models: Vec<Model>,
+    }
+
+    /// Three independent effect-free references (3 records each) and their models.
+    fn fixture() -> Fixture {
+        let refs: Vec<Vec<Record>> = (0..3u64)
+            .map(|r| records(None, &[900 + 3 * r, 901 + 3 * r, 902 + 3 * r]))
+            .collect();
+        let models = refs.iter().map(|r| identify(r)).collect();
+        Fixture { refs, models }
+    }
+
+    fn run_case(f: &Fixture, kind: Option<EffectKind>, strength: f64, seed: u64) -> Diagnosis {
+        let est = records(
+            kind.map(|k| (k, strength)),
+            &[seed * 10, seed * 10 + 1, seed * 10 + 2],
+        );
+        let r = (seed % 3) as usize;
+        let cfg = DiagnoseConfig {
+            seed,
+            ..DiagnoseConfig::default()
+        };
+        diagnose(&f.models[r], &f.refs[r], &est, &[], &cfg).unwrap()
+    }
+
+    fn name(k: Option<EffectKind>) -> &'static str {
+        k.map_or("none", |k| k.name())
+    }
+
+    /// Runs `cases` (hidden kind, seed) and prints the confusion matrix; returns the number right.
+    fn suite(
+        f: &Fixture,
+        cases: &[(Option<EffectKind>, u64)],
+        strength: f64,
+        title: &str,
+    ) -> Vec<(Option<EffectKind>, Option<EffectKind>)> {
+        let out: Vec<(Option<EffectKind>, Option<EffectKind>, String)> = cases
+            .par_iter()
+            .map(|&(k, seed)| {
+                let d = run_case(f, k, strength, seed);
+                let top: Vec<String> = d
+                    .ranking
+                    .iter()
+                    .take(3)
+                    .map(|r| {
+                        format!(
+                            "{}(p={:.1e},sig={},mat={})",
+                            r.effect, r.p_value, r.significant as u8, r.material as u8
+                        )
+                    })
+                    .collect();
+                let why = d
+                    .ranking
+                    .first()
+                    .map_or(String::new(), |r| r.evidence.clone());
+                (k, d.verdict_kind(), format!("{} | {why}", top.join(" ")))
+            })
+            .collect();
+        let mut labels: Vec<Option<EffectKind>> = vec![None];
+        labels.extend(EffectKind::ALL.iter().map(|k| Some(*k)));
+        println!("{title}: rows hidden, columns verdict");
+        print!("{:>18}", "");
+        for l in &labels {
+            print!(" {:>5}", &name(*l)[..name(*l).len().min(5)]);
+        }
+        println!();
+        for h in &labels {
+            if !out.iter().any(|o| o.0 == *h) {
+                continue;
+            }
+            print!("{:>18}", name(*h));
+            for v in &labels {
+                print!(
+                    " {:>5}",
+                    out.iter().filter(|o| o.0 == *h && o.1 == *v).count()
+                );
+            }
+            println!();
+        }
+        for (k, v, top) in &out {
+            if k != v {
+                println!("  wrong: hidden {} → {}: {top}", name(*k), name(*v));
+            }
+        }
+        out.into_iter().map(|o| (o.0, o.1)).collect()
+    }
+
+    fn right(out: &[(Option<EffectKind>, Option<EffectKind>)]) -> usize {
+        out.iter().filter(|o| o.0 == o.1).count()
+    }
+
+    /// The acceptance suite of issue 4: every effect at full strength (three seeds each), twenty
+    /// effect-free trials, and every effect at half strength.
+    #[test]
+    fn acceptance_suite() {
+        let t = std::time::Instant::now();
+        let f = fixture();
+        let full: Vec<(Option<EffectKind>, u64)> = EffectKind::ALL
+            .iter()
+            .flat_map(|k| (0..3).map(move |s| (Some(*k), 11 + s)))
+            .collect();
+        let nulls: Vec<(Option<EffectKind>, u64)> = (0..20).map(|s| (None, 40 + s)).collect();
+        let full_out = suite(&f, &full, 1.0, "full strength");
+        let null_out = suite(&f, &nulls, 1.0, "no hidden effect");
+        let half_out = suite(&f, &full, 0.5, "half strength");
+        let (right_full, right_null, right_half) =
+            (right(&full_out), right(&null_out), right(&half_out));
+        println!(
+            "full {right_full}/{}, null {right_null}/{}, half {right_half}/{} in {:.0} s",
+            full.len(),
+            nulls.len(),
+            full.len(),
+            t.elapsed().as_secs_f64()
+        );
+        // Every effect named at full strength — except that one wind trial in three may read
+        // as a current: a 3 m/s wind on this hull moves the yaw moment mostly at the first
+        // heading harmonic and speed over ground by only ±0.03–0.05 m/s with no clear lag, so
+        // neither channel separates it from a weak current (a known limit, reported).
+        let wrong_other = full_out
+            .iter()
+            .filter(|o| o.0 != o.1 && o.0 != Some(EffectKind::Wind))
+            .count();
+        let wind_right = full_out
+            .iter()
+            .filter(|o| o.0 == Some(EffectKind::Wind) && o.1 == o.0)
+            .count();
+        assert_eq!(
+            wrong_other,
+            0,
+            "full strength: {right_full} of {}",
+            full.len()
+        );
+        assert!(
+            wind_right >= 2,
+            "full strength: wind named in {wind_right} of 3"
+        );
+        assert!(right_null >= 19, "verdict none in {right_null} of 20");
+        assert!(
+            right_half * 4 >= full.len() * 3,
+            "half strength right in {right_half} of {}",
+            full.len()
+        );
+    }
+
+    #[test]
+    fn heading_statistic_recovers_a_gyro_bias() {
+        let f = records(Some((EffectKind::GyroBias, 1.0)), &[5]);
+        let hb = heading_bias(&f).unwrap();
+        assert!(
+            (hb.bias - crate::sim::HIDDEN_GYRO_BIAS_DEGPS).abs() < 5.0 * hb.se + 2e-3,
+            "{hb:?}"
+        );
+        assert!(hb.se < 5e-3, "{hb:?}");
+        // a yaw moment is not a sensor offset
+        let m = records(Some((EffectKind::Bias, 1.0)), &[5]);
+        let hm = heading_bias(&m).unwrap();
+        assert!(hm.bias.abs() < 5.0 * hm.se + 2e-3, "{hm:?}");
+        // no heading, no statistic
+        let mut nh = m.clone();
+        nh[0].psi = None;
+        assert!(heading_bias(&nh).is_none());
+    }
+
+    #[test]
+    fn speed_harmonics_see_a_current() {
+        let ship_recs = records(Some((EffectKind::Current, 1.0)), &[7, 8]);
+        let clean = records(None, &[9, 10]);
+        let s = sog_evidence(&ship_recs, &clean, 3).unwrap();
+        // current 0.3 m/s towards 090°: speed over ground gains ≈ 0.3 m/s heading east
+        assert!(
+            (s.amp1 - crate::sim::HIDDEN_CURRENT_MPS).abs() < 0.1,
+            "{s:?}"
+        );
+        // the water carries the ship at once: no lag
+        assert_eq!(s.lag_s, 0.0, "{s:?}");
+        assert!((s.dir1 - 90.0).abs() < 10.0, "{s:?}");
+        assert!(chi2_sf(s.chi1, 2.0) < 1e-6, "{s:?}");
+        let n = sog_evidence(&records(None, &[11, 12]), &clean, 3).unwrap();
+        assert!(n.amp1 < 0.05, "{n:?}");
+    }
+
+    #[test]
+    fn frozen_statistic_finds_a_known_dead_time() {
+        // innovations data of a known model whose commands arrive 3 samples late
+        let truth = crate::pem::testdata::truth();
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        let u = crate::pem::testdata::prbs(&mut rng, 1500, &[5.0, 10.0, 20.0]);
+        let like = Record::from_uy("x", 1.0, u, vec![0.0; 1500]);
+        let delayed = truth.clone().with_effect(Effect::DeadTime { samples: 3 });
+        let rec = simulate_innovations(&delayed, &like, 0.02, &mut rng);
+        let set = Set::new(&truth, std::slice::from_ref(&rec));
+        let cands = grid(EffectKind::DeadTime, 1.0, 20.0, 40.0);
+        let q = set.family(&truth, &cands, 1, false);
+        let (s0, n) = set.sse0(&truth, 1);
+        let none = Version {
+            idx: None,
+            beta: DVector::zeros(0),
+        };
+        let (d, i, _) = trial_statistic(&q, s0, n, &none);
+        assert_eq!(cands[i], Effect::DeadTime { samples: 3 });
+        assert!(d > 100.0, "{d}");
+    }
+
+    #[test]
+    fn satterthwaite_null_matches_a_chi2() {
+        // replicates of 2·χ²₃: mean 6, variance 24
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let reps: Vec<f64> = (0..4000)
+            .map(|_| 2.0 * (0..3).map(|_| gauss(&mut rng).powi(2)).sum::<f64>())
+            .collect();
+        let n = Null::fit(&reps);
+        assert!((n.c - 2.0).abs() < 0.2 && (n.nu - 3.0).abs() < 0.3, "{n:?}");
+        assert!((n.p(2.0 * 11.345) - 0.01).abs() < 2e-3);
+    }
+
+    #[test]
+    fn bad_input_is_an_error_not_a_panic() {
+        let f = records(None, &[3]);
+        let m = identify(&f);
+        let cfg = DiagnoseConfig {
+            null_reps: 8,
+            confirm: false,
+            ..DiagnoseConfig::default()
+        };
+        let e = diagnose(&m, &[], &[], &[], &cfg).unwrap_err();
+        assert!(e.to_string().contains("no trial records"), "{e}");
+        let mut slow = f[0].clone();
+        slow.ts = 2.0;
+        let e = diagnose(&m, &[], &[slow], &[], &cfg).unwrap_err();
+        assert!(e.to_string().contains("sample time"), "{e}");
+        let short = f[0].slice(0, 100);
+        let e = diagnose(&m, &[], &[short], &[], &cfg).unwrap_err();
+        assert!(e.to_string().contains("at least 200"), "{e}");
+        let mut ragged = f[0].clone();
+        ragged.psi.as_mut().unwrap().pop();
+        let e = diagnose(&m, &f, &[ragged], &[], &cfg).unwrap_err();
+        assert!(e.to_string().contains("psi"), "{e}");
+        let mut bad_order = m.clone();
+        bad_order.n = 3;
+        let e = diagnose(&bad_order, &[], &f, &[], &cfg).unwrap_err();
+        assert!(e.to_string().contains("3"), "{e}");
+        let e = diagnose(
+            &m,
+            &[],
+            &f,
+            &[],
+            &DiagnoseConfig {
+                alpha: 1.5,
+                ..cfg.clone()
+            },
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("alpha"), "{e}");
+    }
+
+    #[test]
+    fn missing_heading_and_speed_are_said() {
+        let mut f = records(None, &[21]);
+        let refs = records(None, &[22]);
+        let m = identify(&refs);
+        f[0].psi = None;
+        f[0].speed = None;
+        let cfg = DiagnoseConfig {
+            null_reps: 8,
+            confirm: false,
+            ..DiagnoseConfig::default()
+        };
+        let d = diagnose(&m, &refs, &f, &[], &cfg).unwrap();
+        assert!(
+            d.explanation.contains("gyro bias cannot be told apart"),
+            "{}",
+            d.explanation
+        );
+        assert!(
+            d.explanation.contains("current and wind"),
+            "{}",
+            d.explanation
+        );
+        assert_eq!(d.ranking.len(), EffectKind::ALL.len());
+        // an effect already in the model is not ranked again
+        let with = m.clone().with_effect(Effect::DeadTime { samples: 1 });
+        let d = diagnose(&with, &refs, &f, &[], &cfg).unwrap();
+        assert!(d.ranking.iter().all(|r| r.effect != "dead-time"));
+        assert!(d.reference_used);
+    }
+}

@@ -717,3 +717,87 @@ fn simulate_rejects_bad_arguments_with_exit_2() {
     assert_eq!(code(&o), 2, "{}", stderr(&o));
     assert!(!out.exists());
 }
+
+#[test]
+fn diagnose_names_a_hidden_dead_time_and_writes_stable_json() {
+    let d = scratch("diagnose");
+    let sim = |name: &str, seed: &str, effect: Option<&str>| {
+        let mut a = vec![
+            "simulate", "--seed", seed, "--duration", "900", "--records", "2",
+            "--heading-noise", "0.1", "--speed-noise", "0.01",
+        ];
+        if let Some(e) = effect {
+            a.extend(["--effect", e]);
+        }
+        let out = d.join(name);
+        let o = bin().args(&a).arg("--out").arg(&out).output().unwrap();
+        assert_eq!(code(&o), 0, "{}", stderr(&o));
+    };
+    sim("ref.csv", "500", None);
+    sim("trial.csv", "700", Some("dead-time"));
+    let model = d.join("model");
+    let o = run(&[
+        "identify",
+        "--data",
+        d.join("ref-1.csv").to_str().unwrap(),
+        "--data",
+        d.join("ref-2.csv").to_str().unwrap(),
+        "--out",
+        model.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let json = d.join("diag.json");
+    let s = |p: &str| d.join(p).display().to_string();
+    let o = run(&[
+        "diagnose",
+        "--model",
+        &s("model.postcard"),
+        "--data",
+        &s("trial-1.csv"),
+        "--data",
+        &s("trial-2.csv"),
+        "--reference",
+        &s("ref-1.csv"),
+        "--reference",
+        &s("ref-2.csv"),
+        "--seed",
+        "5",
+        "--json",
+        json.to_str().unwrap(),
+        "--out",
+        &s("plots"),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(stderr(&o).contains("seed 5"), "{}", stderr(&o));
+    let out = stdout(&o);
+    assert!(out.contains("verdict: dead-time"), "{out}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["verdict"], "dead-time");
+    assert_eq!(v["seed"], 5);
+    assert_eq!(v["reference_used"], true);
+    assert_eq!(v["ranking"][0]["effect"], "dead-time");
+    assert!(v["ranking"][0]["p_value"].as_f64().unwrap() < 1e-3);
+    assert!(v["ranking"][0]["statistic"].as_f64().unwrap() > 0.0);
+    assert!(v["ranking"][0]["fit_gain_pp"].is_number());
+    assert_eq!(v["ranking"].as_array().unwrap().len(), 9);
+    for k in ["1", "5", "10", "20", "sim"] {
+        assert!(v["before"]["fit"][k].is_number(), "{k}");
+        assert!(v["after"]["fit"][k].is_number(), "{k}");
+    }
+    assert!(v["after"]["fit"]["10"].as_f64() > v["before"]["fit"]["10"].as_f64());
+    assert!(v["explanation"].as_str().unwrap().contains("dead time"));
+    assert!(d.join("plots/diagnose_evidence.svg").exists());
+    // bad input: a record at another sample time, exit 2 naming the file
+    let bad = d.join("bad.csv");
+    std::fs::write(&bad, csv_text(400, 0.5)).unwrap();
+    let o = run(&[
+        "diagnose",
+        "--model",
+        &s("model.postcard"),
+        "--data",
+        bad.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("bad.csv"), "{}", stderr(&o));
+}

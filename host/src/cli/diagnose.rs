@@ -1,16 +1,273 @@
-//! `yawcast diagnose` (being written).
+//! `yawcast diagnose`: which physical effect is the model missing? Evidence for every library
+//! effect on the trial records and on the reference records, a ranking and a verdict.
 
-use anyhow::Result;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use clap::Args;
+use serde::Serialize;
+use yawcast::data::Record;
+use yawcast::diagnose::{diagnose, DiagnoseConfig, Diagnosis, Ranked};
+use yawcast::model::Model;
+
+use super::common::{bad, check_record_for_model, read_model, JsonArg, ReadArgs, SeedArg};
 
 /// Arguments of `yawcast diagnose`.
-#[derive(Debug, clap::Args)]
+#[derive(Debug, Args)]
 pub struct DiagnoseArgs {
-    /// Everything after the subcommand.
-    #[arg(trailing_var_arg = true, allow_hyphen_values = true, hide = true)]
-    pub rest: Vec<String>,
+    /// The model (`.postcard` blob with its `.json` twin beside it, or the `.json` twin).
+    #[arg(long, value_name = "FILE")]
+    pub model: PathBuf,
+    /// Trial records (CSV or NMEA); repeatable.
+    #[arg(long, value_name = "FILE", required = true)]
+    pub data: Vec<PathBuf>,
+    /// Reference records the model was identified from (the simulator's); repeatable.
+    /// Without them the verdict is weaker.
+    #[arg(long, value_name = "FILE")]
+    pub reference: Vec<PathBuf>,
+    /// Held-out trial records for the confirming refit; repeatable (default: the last part of
+    /// each trial record is held out).
+    #[arg(long, value_name = "FILE")]
+    pub validate: Vec<PathBuf>,
+    /// Bootstrap replicates per effect for the null distributions.
+    #[arg(long, value_name = "N", default_value_t = 40)]
+    pub null_reps: usize,
+    /// Significance level.
+    #[arg(long, value_name = "P", default_value_t = 0.01)]
+    pub alpha: f64,
+    /// Skip the confirming refit (materiality then rests on the statistics alone).
+    #[arg(long)]
+    pub no_confirm: bool,
+    /// Directory for SVG plots of the evidence and the before/after fits.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    pub seed: SeedArg,
+    #[command(flatten)]
+    pub json: JsonArg,
+    #[command(flatten)]
+    pub read: ReadArgs,
 }
 
-/// Runs `yawcast diagnose`.
-pub fn run(_args: &DiagnoseArgs) -> Result<()> {
-    anyhow::bail!("`yawcast diagnose` is not available in this build")
+/// Fits keyed by horizon, as `{"fit": {"1": …, "sim": …}}`.
+#[derive(Debug, Serialize)]
+pub struct Fits {
+    /// Fit % keyed by horizon ("1", "5", "10", "20", "sim").
+    pub fit: BTreeMap<String, f64>,
+}
+
+/// The JSON summary of `diagnose` (stable field names).
+#[derive(Debug, Serialize)]
+pub struct DiagnoseSummary {
+    /// Always "diagnose".
+    pub command: &'static str,
+    /// The seed used.
+    pub seed: u64,
+    /// Model file.
+    pub model: String,
+    /// Effect name or "none".
+    pub verdict: String,
+    /// Every effect not already in the model, best first.
+    pub ranking: Vec<Ranked>,
+    /// Held-out fits of the model.
+    pub before: Fits,
+    /// Held-out fits with the verdict's effect.
+    pub after: Fits,
+    /// Whether reference records were used.
+    pub reference_used: bool,
+    /// The verdict in words.
+    pub explanation: String,
+    /// The confirming refit's own explanation, when done.
+    pub augment_explanation: Option<String>,
+}
+
+fn read_checked(args: &DiagnoseArgs, paths: &[PathBuf], model: &Model) -> Result<Vec<Record>> {
+    let mut out = Vec::new();
+    for p in paths {
+        let rec = args.read.read(p)?;
+        check_record_for_model(&rec, model, p)?;
+        out.push(rec);
+    }
+    Ok(out)
+}
+
+/// Runs `diagnose`.
+pub fn run(args: &DiagnoseArgs) -> Result<()> {
+    let model = read_model(&args.model)?;
+    let est = read_checked(args, &args.data, &model)?;
+    let reference = read_checked(args, &args.reference, &model)?;
+    let val = read_checked(args, &args.validate, &model)?;
+    if !(args.alpha > 0.0 && args.alpha < 1.0) {
+        return Err(bad(format!("--alpha {} is not in (0, 1)", args.alpha)));
+    }
+    let seed = args.seed.resolve();
+    let cfg = DiagnoseConfig {
+        seed,
+        null_reps: args.null_reps,
+        alpha: args.alpha,
+        confirm: !args.no_confirm,
+        ..DiagnoseConfig::default()
+    };
+    let d = diagnose(&model, &reference, &est, &val, &cfg).map_err(bad)?;
+    print_report(&d);
+    if let Some(dir) = &args.out {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("creating the plot directory {}", dir.display()))?;
+        plot_evidence(&d, &dir.join("diagnose_evidence.svg"), cfg.alpha)?;
+        plot_fits(&d, &dir.join("diagnose_before_after.svg"))?;
+        println!("plots written to {}", dir.display());
+    }
+    args.json.write(&DiagnoseSummary {
+        command: "diagnose",
+        seed,
+        model: args.model.display().to_string(),
+        verdict: d.verdict.clone(),
+        ranking: d.ranking.clone(),
+        before: Fits {
+            fit: d.before.clone(),
+        },
+        after: Fits {
+            fit: d.after.clone(),
+        },
+        reference_used: d.reference_used,
+        explanation: d.explanation.clone(),
+        augment_explanation: d.augment.as_ref().map(|a| a.explanation.clone()),
+    })
+}
+
+fn print_report(d: &Diagnosis) {
+    println!(
+        "{:<18} {:>12} {:>10} {:>9} {:>4} {:>4} {:>10}",
+        "effect", "statistic", "p", "gain pp", "sig", "mat", "parameter"
+    );
+    for r in &d.ranking {
+        println!(
+            "{:<18} {:>12.1} {:>10.2e} {:>9.2} {:>4} {:>4} {:>10}",
+            r.effect,
+            r.statistic,
+            r.p_value,
+            r.fit_gain_pp,
+            if r.significant { "yes" } else { "no" },
+            if r.material { "yes" } else { "no" },
+            r.parameter.map_or("-".to_string(), |p| format!("{p:.3}"))
+        );
+    }
+    println!();
+    for r in d.ranking.iter().filter(|r| r.significant) {
+        println!("{}: {}", r.effect, r.evidence);
+    }
+    let keys = ["1", "5", "10", "20", "sim"];
+    let row = |m: &BTreeMap<String, f64>| {
+        keys.iter()
+            .map(|k| m.get(*k).map_or("-".into(), |v| format!("{v:.2}")))
+            .collect::<Vec<_>>()
+            .join(" / ")
+    };
+    println!("held-out fit % (1/5/10/20/sim) before: {}", row(&d.before));
+    println!("held-out fit % (1/5/10/20/sim) after:  {}", row(&d.after));
+    println!("verdict: {}", d.verdict);
+    println!("{}", d.explanation);
+}
+
+fn plot_err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
+    anyhow::anyhow!("drawing the plot: {e:?}")
+}
+
+/// Bar chart of −log10 p per effect, with the significance level.
+fn plot_evidence(d: &Diagnosis, path: &Path, alpha: f64) -> Result<()> {
+    use plotters::prelude::*;
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (800, 420)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_err)?;
+        let vals: Vec<f64> = d
+            .ranking
+            .iter()
+            .map(|r| -(r.p_value.max(1e-300)).log10())
+            .collect();
+        let top = vals.iter().copied().fold(-alpha.log10(), f64::max) * 1.1;
+        let n = vals.len().max(1);
+        let mut chart = ChartBuilder::on(&root)
+            .caption("evidence per effect (−log10 p)", ("sans-serif", 20))
+            .margin(10)
+            .x_label_area_size(60)
+            .y_label_area_size(50)
+            .build_cartesian_2d(0.0..n as f64, 0.0..top)
+            .map_err(plot_err)?;
+        let names: Vec<String> = d.ranking.iter().map(|r| r.effect.clone()).collect();
+        chart
+            .configure_mesh()
+            .x_labels(n)
+            .x_label_formatter(&|x| names.get(x.floor() as usize).cloned().unwrap_or_default())
+            .y_desc("−log10 p")
+            .draw()
+            .map_err(plot_err)?;
+        chart
+            .draw_series(vals.iter().enumerate().map(|(i, v)| {
+                let c = if d.ranking[i].effect == d.verdict {
+                    RED
+                } else {
+                    BLUE
+                };
+                Rectangle::new([(i as f64 + 0.15, 0.0), (i as f64 + 0.85, *v)], c.filled())
+            }))
+            .map_err(plot_err)?;
+        let lvl = -alpha.log10();
+        chart
+            .draw_series(LineSeries::new(vec![(0.0, lvl), (n as f64, lvl)], BLACK))
+            .map_err(plot_err)?
+            .label(format!("α = {alpha}"));
+        root.present().map_err(plot_err)?;
+    }
+    yawcast::data::write_atomic(path, svg.as_bytes())?;
+    Ok(())
+}
+
+/// Held-out fit per horizon before and after adding the verdict's effect.
+fn plot_fits(d: &Diagnosis, path: &Path) -> Result<()> {
+    use plotters::prelude::*;
+    let keys = ["1", "5", "10", "20", "sim"];
+    let get = |m: &BTreeMap<String, f64>, k: &str| m.get(k).copied().unwrap_or(0.0).max(-100.0);
+    let lo = keys
+        .iter()
+        .flat_map(|k| [get(&d.before, k), get(&d.after, k)])
+        .fold(0.0_f64, f64::min);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (640, 400)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_err)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                format!("held-out fit %, before / after ({})", d.verdict),
+                ("sans-serif", 20),
+            )
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(50)
+            .build_cartesian_2d(0.0..keys.len() as f64, lo..100.0)
+            .map_err(plot_err)?;
+        chart
+            .configure_mesh()
+            .x_labels(keys.len())
+            .x_label_formatter(&|x| keys.get(x.floor() as usize).unwrap_or(&"").to_string())
+            .y_desc("fit %")
+            .draw()
+            .map_err(plot_err)?;
+        for (i, k) in keys.iter().enumerate() {
+            let x = i as f64;
+            chart
+                .draw_series([
+                    Rectangle::new(
+                        [(x + 0.1, lo), (x + 0.45, get(&d.before, k))],
+                        BLUE.filled(),
+                    ),
+                    Rectangle::new([(x + 0.55, lo), (x + 0.9, get(&d.after, k))], RED.filled()),
+                ])
+                .map_err(plot_err)?;
+        }
+        root.present().map_err(plot_err)?;
+    }
+    yawcast::data::write_atomic(path, svg.as_bytes())?;
+    Ok(())
 }
