@@ -1,16 +1,326 @@
-//! `yawcast augment` (being written).
+//! `yawcast augment`: add a library effect to a model, re-identify it, compare held-out fits
+//! before and after, export the result, and optionally write the effect into a ship file.
 
-use anyhow::Result;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use clap::Args;
+use serde::Serialize;
+use yawcast::augment::{self, AugmentConfig, AugmentError, AugmentReport};
+use yawcast::data::Record;
+use yawcast::export;
+use yawcast::model::Model;
+use yawcast::sim::{Ship, SimEffect};
+use yawcast_shared::model::EffectKind;
+
+use super::common::{bad, check_record_for_model, read_model, JsonArg, ReadArgs, SeedArg};
 
 /// Arguments of `yawcast augment`.
-#[derive(Debug, clap::Args)]
+#[derive(Debug, Args)]
 pub struct AugmentArgs {
-    /// Everything after the subcommand.
-    #[arg(trailing_var_arg = true, allow_hyphen_values = true, hide = true)]
-    pub rest: Vec<String>,
+    /// The model to augment (`.postcard` blob with its `.json` twin, or the `.json` twin).
+    #[arg(long, value_name = "FILE")]
+    pub model: PathBuf,
+    /// The effect to add (bias, gyro-bias, dead-time, rate-limit, saturation, asymmetry,
+    /// nonlinear-damping, wind, current), or `auto` for the verdict of `yawcast diagnose`.
+    #[arg(long, value_name = "NAME")]
+    pub effect: String,
+    /// Estimation records (CSV or NMEA); repeatable.
+    #[arg(long, value_name = "FILE", required = true)]
+    pub data: Vec<PathBuf>,
+    /// Validation records; repeatable. Without them the last third of each estimation
+    /// record is held out.
+    #[arg(long, value_name = "FILE")]
+    pub validate: Vec<PathBuf>,
+    /// Reference records the model was identified from (the simulator's), for `--effect auto`.
+    #[arg(long, value_name = "FILE")]
+    pub reference: Vec<PathBuf>,
+    /// Where the augmented model goes: `<PATH>.postcard` and its `<PATH>.json` twin (the
+    /// input model unchanged when the effect is not kept).
+    #[arg(long, value_name = "PATH")]
+    pub out: PathBuf,
+    /// Also write the effect, in physical units, into this ship file (created from the
+    /// built-in ship when missing); only when the effect is kept.
+    #[arg(long, value_name = "SHIP.toml")]
+    pub ship: Option<PathBuf>,
+    #[command(flatten)]
+    pub json: JsonArg,
+    #[command(flatten)]
+    pub seed: SeedArg,
+    #[command(flatten)]
+    pub read: ReadArgs,
+}
+
+/// Fits of one model, keyed by horizon.
+#[derive(Debug, Serialize)]
+pub struct Fits {
+    /// Held-out fit % keyed by horizon ("1", "5", "10", "20", "sim").
+    pub fit: BTreeMap<String, f64>,
+}
+
+/// The JSON summary of `augment`.
+#[derive(Debug, Serialize)]
+pub struct AugmentSummary {
+    /// Always "augment".
+    pub command: &'static str,
+    /// The effect tried (its library name).
+    pub effect: String,
+    /// Whether `--effect auto` chose it.
+    pub auto: bool,
+    /// Whether it was kept.
+    pub kept: bool,
+    /// The input model on the held-out records.
+    pub before: Fits,
+    /// The input structure re-identified on the estimation records.
+    pub baseline: Fits,
+    /// The augmented model.
+    pub after: Fits,
+    /// after − baseline at 10 steps (pp).
+    pub fit_gain_pp: f64,
+    /// ΔAIC candidate − baseline.
+    pub delta_aic: f64,
+    /// ΔBIC candidate − baseline.
+    pub delta_bic: f64,
+    /// Ljung–Box p of the input model's held-out one-step residuals.
+    pub ljung_box_p_before: f64,
+    /// Ljung–Box p of the augmented model's.
+    pub ljung_box_p_after: f64,
+    /// The augmented model's effect with its estimated parameters.
+    pub estimated: Option<yawcast::model::Effect>,
+    /// STD% of the augmented model's parameters.
+    pub std_pct: Vec<f64>,
+    /// Physical words with numbers.
+    pub explanation: String,
+    /// The model blob written.
+    pub out: PathBuf,
+    /// The ship file written, or null.
+    pub ship: Option<PathBuf>,
+    /// The effect written into the ship file (physical units), or null.
+    pub sim_effect: Option<SimEffect>,
+}
+
+fn parse_effect(name: &str) -> Result<Option<EffectKind>> {
+    if name == "auto" {
+        return Ok(None);
+    }
+    EffectKind::from_name(name).map(Some).ok_or_else(|| {
+        let names: Vec<&str> = EffectKind::ALL.iter().map(|k| k.name()).collect();
+        bad(format!(
+            "--effect: unknown effect `{name}`; valid names: {}, auto",
+            names.join(", ")
+        ))
+    })
+}
+
+fn read_checked(read: &ReadArgs, paths: &[PathBuf], model: &Model) -> Result<Vec<Record>> {
+    paths
+        .iter()
+        .map(|p| {
+            let r = read.read(p)?;
+            check_record_for_model(&r, model, p)?;
+            Ok(r)
+        })
+        .collect()
+}
+
+/// The library error as a CLI error: everything but a numerical failure is bad input.
+fn cli_err(e: AugmentError) -> anyhow::Error {
+    match e {
+        AugmentError::Ident(yawcast::pem::IdentError::AllStartsFailed(_))
+        | AugmentError::Ident(yawcast::pem::IdentError::Unstable) => {
+            anyhow::Error::new(e).context("augment")
+        }
+        other => bad(other),
+    }
 }
 
 /// Runs `yawcast augment`.
-pub fn run(_args: &AugmentArgs) -> Result<()> {
-    anyhow::bail!("`yawcast augment` is not available in this build")
+pub fn run(args: &AugmentArgs) -> Result<()> {
+    let kind = parse_effect(&args.effect)?;
+    let (_, twin) = export::paths(&args.out);
+    if args.json.json.as_ref() == Some(&twin) {
+        return Err(bad(format!(
+            "--json {} is the JSON twin of the model written by --out; choose another name",
+            twin.display()
+        )));
+    }
+    let model = read_model(&args.model)?;
+    let est = read_checked(&args.read, &args.data, &model)?;
+    let val = read_checked(&args.read, &args.validate, &model)?;
+    let reference = read_checked(&args.read, &args.reference, &model)?;
+    let seed = args.seed.resolve();
+    let (kind, auto) = match kind {
+        Some(k) => (k, false),
+        None => (choose_auto(&model, &reference, &est, &val, seed)?, true),
+    };
+    let cfg = AugmentConfig::default();
+    let t0 = std::time::Instant::now();
+    let rep = augment::augment(&model, kind, &est, &val, &cfg).map_err(cli_err)?;
+    print_report(&rep, t0.elapsed().as_secs_f64());
+
+    let check = val
+        .first()
+        .or(est.first())
+        .context("no record to check the export on")?;
+    let ex = export::export(&rep.model, &args.out, check)
+        .with_context(|| format!("writing the model {}", args.out.display()))?;
+    println!(
+        "model written to {} and {}{}",
+        ex.blob_path.display(),
+        ex.json_path.display(),
+        if rep.kept {
+            ""
+        } else {
+            " (the input model, unchanged)"
+        }
+    );
+
+    let mut ship_written = None;
+    let mut sim_effect = None;
+    if let Some(path) = &args.ship {
+        if rep.kept {
+            let eff = rep.model.effect(kind).copied();
+            let (ship, se) = write_ship(path, eff.as_ref(), &rep.model)?;
+            println!(
+                "ship file {} ({}) now carries {}",
+                path.display(),
+                ship.name,
+                describe_sim(&se)
+            );
+            ship_written = Some(path.clone());
+            sim_effect = Some(se);
+        } else {
+            println!(
+                "ship file {} left unchanged: the effect was not kept",
+                path.display()
+            );
+        }
+    }
+    args.json.write(&AugmentSummary {
+        command: "augment",
+        effect: kind.name().to_string(),
+        auto,
+        kept: rep.kept,
+        before: Fits {
+            fit: rep.before.clone(),
+        },
+        baseline: Fits {
+            fit: rep.baseline.clone(),
+        },
+        after: Fits {
+            fit: rep.after.clone(),
+        },
+        fit_gain_pp: rep.fit_gain_pp,
+        delta_aic: rep.delta_aic,
+        delta_bic: rep.delta_bic,
+        ljung_box_p_before: rep.ljung_box_p_before,
+        ljung_box_p_after: rep.ljung_box_p_after,
+        estimated: rep.candidate.effect(kind).copied(),
+        std_pct: rep.std_pct.clone(),
+        explanation: rep.explanation.clone(),
+        out: ex.blob_path,
+        ship: ship_written,
+        sim_effect,
+    })
+}
+
+/// `--effect auto`: the verdict of the diagnosis.
+fn choose_auto(
+    _model: &Model,
+    _reference: &[Record],
+    _est: &[Record],
+    _val: &[Record],
+    _seed: u64,
+) -> Result<EffectKind> {
+    Err(bad(
+        "--effect auto needs `yawcast diagnose`, which is not available in this build; \
+         name the effect",
+    ))
+}
+
+/// Reads (or creates from the built-in ship) the ship file, adds the effect in physical
+/// units and writes it back atomically.
+fn write_ship(
+    path: &Path,
+    effect: Option<&yawcast::model::Effect>,
+    model: &Model,
+) -> Result<(Ship, SimEffect)> {
+    let ship = if path.exists() {
+        Ship::from_file(path).map_err(bad)?
+    } else {
+        eprintln!(
+            "{} does not exist: starting from the built-in ship",
+            path.display()
+        );
+        Ship::default_lng()
+    };
+    let effect = effect.context("the kept model lacks the effect")?;
+    let se = augment::to_sim_effect(effect, model, &ship).ok_or_else(|| {
+        anyhow::anyhow!(
+            "the estimated {} has no physical counterpart in the simulator \
+             (e.g. damping of the wrong sign); ship file not written",
+            effect.kind().name()
+        )
+    })?;
+    let ship = ship.with_effect(se);
+    let text = ship.to_toml_string().map_err(bad)?;
+    yawcast::data::write_atomic(path, text.as_bytes())
+        .with_context(|| format!("writing the ship file {}", path.display()))?;
+    Ok((ship, se))
+}
+
+fn describe_sim(e: &SimEffect) -> String {
+    match *e {
+        SimEffect::Bias { yaw_moment_nm } => format!("a yaw moment of {yaw_moment_nm:.1} N·m"),
+        SimEffect::GyroBias { bias_degps } => format!("a gyro bias of {bias_degps:.3} °/s"),
+        SimEffect::DeadTime { delay_s } => format!("a dead time of {delay_s:.1} s"),
+        SimEffect::RateLimit { rate_degps } => format!("a slew limit of {rate_degps:.2} °/s"),
+        SimEffect::Saturation { limit_deg } => format!("an angle limit of {limit_deg:.1}°"),
+        SimEffect::Asymmetry { starboard_gain } => {
+            format!("a starboard gain of {:+.0} %", 100.0 * starboard_gain)
+        }
+        SimEffect::NonlinearDamping { n_rr, cubic } => format!(
+            "extra Norrbin damping n_rr = {n_rr:.3}{}",
+            if cubic { " (cubic)" } else { "" }
+        ),
+        SimEffect::Wind {
+            speed_mps,
+            from_deg,
+        } => format!("a wind of {speed_mps:.2} m/s from {from_deg:03.0}°"),
+        SimEffect::Current {
+            speed_mps,
+            towards_deg,
+        } => format!("a current of {speed_mps:.3} m/s towards {towards_deg:03.0}°"),
+    }
+}
+
+fn print_report(rep: &AugmentReport, secs: f64) {
+    println!(
+        "{:>8} {:>10} {:>10} {:>10}",
+        "horizon", "before", "baseline", "after"
+    );
+    let mut keys: Vec<&String> = rep.before.keys().collect();
+    keys.sort_by_key(|k| yawcast::predict::Horizon::parse(k));
+    for k in keys {
+        let b = rep.before[k];
+        println!(
+            "{:>8} {:>10.2} {:>10.2} {:>10.2}",
+            k,
+            b,
+            rep.baseline.get(k).copied().unwrap_or(f64::NAN),
+            rep.after.get(k).copied().unwrap_or(f64::NAN)
+        );
+    }
+    println!(
+        "{}: {} (ΔAIC {:+.1}, ΔBIC {:+.1}, Ljung–Box p {:.3} → {:.3}; {:.1} s)",
+        rep.effect.name(),
+        if rep.kept { "kept" } else { "not kept" },
+        rep.delta_aic,
+        rep.delta_bic,
+        rep.ljung_box_p_before,
+        rep.ljung_box_p_after,
+        secs
+    );
+    println!("{}", rep.explanation);
 }
