@@ -26,10 +26,15 @@
 //! - **Encompassing test between the top two**: both effects fitted jointly; what each adds
 //!   given the other decides between look-alikes (dead time vs slew limit, bias vs current
 //!   vs wind).
-//! - **Significant and material.** An effect is reported when it is significant and, refitted
-//!   by PEM with the effect (see [`crate::augment`]), improves held-out prediction — or, for
+//! - **Significant and material.** Each effect is judged at level α/m (m effects tested,
+//!   Bonferroni), and reported only when it also improves held-out prediction (θ frozen, the
+//!   effect's gains fitted on the estimation part, fit at 10 steps or in simulation) — or, for
 //!   effects the yaw prediction cannot see well, when its own channel shows it (heading for
-//!   a gyro bias, speed over ground for current and wind).
+//!   a gyro bias, speed over ground for current and wind). The verdict's effect is then
+//!   refitted with the model ([`crate::augment::augment`]) for the before/after fits.
+//! - **Current or wind.** When speed over ground depends on heading, a current moves the ship
+//!   at once (kinematics) while wind acts through the surge dynamics: the lag with which
+//!   heading harmonics explain speed over ground best decides between the two.
 //!
 //! Effects already in the model are skipped, so diagnosing an augmented model looks for the
 //! next one.
@@ -101,9 +106,10 @@ pub struct Ranked {
     /// p-value against the calibrated null.
     pub p_value: f64,
     /// Held-out fit gain (percentage points, at the effect's horizon: 10 steps for actuator and
-    /// hull effects, `sim` for slow ones) of the refit model; 0 when not refitted.
+    /// hull effects, `sim` for slow ones) of the model with the effect added (θ frozen, the
+    /// effect's gains fitted on the estimation part); 0 for effects that are not significant.
     pub fit_gain_pp: f64,
-    /// p-value below α.
+    /// p-value below α/m (m: the number of library effects, Bonferroni).
     pub significant: bool,
     /// Held-out improvement on refit, or measurable channel evidence.
     pub material: bool,
@@ -942,11 +948,11 @@ pub fn diagnose(
             let e = &ev[i];
             let r = &ranking[i];
             let mut s = format!(
-                "The trials show {} that the {} lacks: {} (p = {:.2e}, held-out fit gain {:+.1} pp).",
+                "The trials show {} that the {} lacks: {} (p {}, held-out fit gain {:+.1} pp).",
                 describe(e.kind),
                 if has_ref { "reference" } else { "model" },
                 e.words,
-                r.p_value,
+                fmt_p(r.p_value),
                 r.fit_gain_pp
             );
             if let Some(second) = ranking
@@ -955,8 +961,9 @@ pub fn diagnose(
                 .find(|(j, x)| *j != i && x.significant)
             {
                 s.push_str(&format!(
-                    " Runner-up: {} (p = {:.2e}), explained by it.",
-                    second.1.effect, second.1.p_value
+                    " Runner-up: {} (p {}).",
+                    second.1.effect,
+                    fmt_p(second.1.p_value)
                 ));
             }
             if let Some(a) = &aug {
@@ -1029,6 +1036,15 @@ fn split(est: &[Record]) -> (Vec<Record>, Vec<Record>) {
         b.push(r.slice(cut, n));
     }
     (a, b)
+}
+
+/// `= 3.1e-5`, or `< 1e-16` where the number is below what the tail computation resolves.
+fn fmt_p(p: f64) -> String {
+    if p < 1e-16 {
+        "< 1e-16".into()
+    } else {
+        format!("= {p:.1e}")
+    }
 }
 
 fn describe(kind: EffectKind) -> &'static str {
@@ -1408,10 +1424,11 @@ fn encompass(
         (false, false) => simpler_b,
         (true, false) => false,
     };
-    let _ = level;
     let w = format!(
-        "; encompassing test ({h}-step errors): given {nb}, {na} still adds p = {pa:.2e}; given \
-         {na}, {nb} adds p = {pb:.2e}",
+        "; encompassing test ({h}-step errors): given {nb}, {na} still adds (p {}); given \
+         {na}, {nb} adds (p {})",
+        fmt_p(pa),
+        fmt_p(pb),
         na = a.kind.name(),
         nb = b.kind.name()
     );
@@ -1740,6 +1757,33 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.to_string().contains("alpha"), "{e}");
+    }
+
+    #[test]
+    fn without_reference_the_verdict_is_said_to_be_weaker() {
+        let est = records(Some((EffectKind::GyroBias, 1.0)), &[31, 32]);
+        let m = identify(&est);
+        let cfg = DiagnoseConfig {
+            null_reps: 8,
+            confirm: false,
+            ..DiagnoseConfig::default()
+        };
+        let d = diagnose(&m, &[], &est, &[], &cfg).unwrap();
+        assert!(!d.reference_used);
+        assert!(
+            d.explanation.contains("verdict is weaker"),
+            "{}",
+            d.explanation
+        );
+        // the heading channel still sees the sensor offset
+        assert_eq!(
+            d.verdict_kind(),
+            Some(EffectKind::GyroBias),
+            "{}",
+            d.explanation
+        );
+        let g = d.ranking.iter().find(|r| r.effect == "gyro-bias").unwrap();
+        assert!((g.parameter.unwrap() - 0.25).abs() < 0.01, "{g:?}");
     }
 
     #[test]
