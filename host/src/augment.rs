@@ -26,8 +26,8 @@
 //!    survives the f32 export round trip, its ΔBIC against the baseline is negative (an
 //!    actuator parameter counts as one parameter), its paired held-out fit gain over the
 //!    baseline at 10 steps or in simulation is significant against the spread of the gain
-//!    over records (one-sided Student t at 95 %; records are cut into blocks when there are
-//!    fewer than four), neither horizon is significantly worse, and it does not validate
+//!    over records (one-sided Student t at 95 %; records are cut into blocks so that at
+//!    least twelve units carry the spread), neither horizon is significantly worse, and it does not validate
 //!    worse than the input model at 10 steps or in simulation. Otherwise the input model is
 //!    returned unchanged, with the reason.
 
@@ -195,13 +195,13 @@ fn holdout(est: &[Record], n: usize) -> Result<(Vec<Record>, Vec<Record>, String
     })
 }
 
-/// Number of blocks each held-out record is cut into for the spread of the gain.
+/// Units the paired held-out gain is computed on, at least.
+const MIN_UNITS: usize = 12;
+
+/// Number of blocks each held-out record is cut into so that the spread of the gain is
+/// estimated from at least [`MIN_UNITS`] units.
 fn blocks_per_record(records: usize) -> usize {
-    if records >= 4 {
-        1
-    } else {
-        6usize.div_ceil(records.max(1))
-    }
+    MIN_UNITS.div_ceil(records.max(1))
 }
 
 fn evaluate(model: &Model, val: &[Record], horizons: &[Horizon], parallel: bool) -> Eval {
@@ -562,7 +562,16 @@ fn round_trips(m: &Model) -> bool {
         && back.is_stable()
 }
 
-/// The effect in physical words.
+/// The effect in physical words (`ts`: the model's sample time, s).
+///
+/// ```
+/// use yawcast::{augment::describe, model::Effect};
+/// assert_eq!(describe(&Effect::RateLimit { rate: 3.14 }, 1.0), "a slew limit of 3.1 °/s");
+/// assert_eq!(
+///     describe(&Effect::DeadTime { samples: 4 }, 0.5),
+///     "a command dead time of 4 samples (2.0 s)"
+/// );
+/// ```
 pub fn describe(effect: &Effect, ts: f64) -> String {
     match *effect {
         Effect::Bias { beta } => format!(
@@ -731,7 +740,7 @@ pub fn augment(
     if stable && !exports {
         reasons.push("it does not survive the f32 export".into());
     }
-    if !(delta_bic < 0.0) {
+    if delta_bic.is_nan() || delta_bic >= 0.0 {
         reasons.push(format!(
             "ΔBIC = {delta_bic:+.1} ≥ 0 on the estimation records: the extra parameter does not pay for itself"
         ));

@@ -801,3 +801,157 @@ fn diagnose_names_a_hidden_dead_time_and_writes_stable_json() {
     assert_eq!(code(&o), 2, "{}", stderr(&o));
     assert!(stderr(&o).contains("bad.csv"), "{}", stderr(&o));
 }
+
+/// Simulated records written as CSVs through the library: `<name>-<seed>.csv`.
+fn sim_csvs(
+    dir: &Path,
+    name: &str,
+    effect: Option<yawcast::sim::SimEffect>,
+    seeds: &[u64],
+) -> Vec<PathBuf> {
+    use yawcast::sim::{simulate, Scenario, Ship};
+    let sc = Scenario {
+        effects: effect.into_iter().collect(),
+        ..Scenario::default()
+    };
+    seeds
+        .iter()
+        .map(|&seed| {
+            let rec = simulate(&Ship::default_lng(), &sc, seed).unwrap();
+            let p = dir.join(format!("{name}-{seed}.csv"));
+            yawcast::data::write_csv(&p, &rec).unwrap();
+            p
+        })
+        .collect()
+}
+
+#[test]
+fn augment_adds_a_dead_time_exports_it_and_writes_the_ship() {
+    use yawcast::sim::SimEffect;
+    use yawcast_shared::model::EffectKind;
+    let d = scratch("augment");
+    // the model of the effect-free simulator, as a JSON twin
+    let reference = sim_csvs(&d, "ref", None, &[301, 302]);
+    let recs: Vec<_> = reference
+        .iter()
+        .map(|p| yawcast::data::read_csv(p).unwrap())
+        .collect();
+    let base = yawcast::pem::identify(&recs, None, &Default::default())
+        .unwrap()
+        .model;
+    let model = d.join("base.json");
+    std::fs::write(&model, serde_json::to_string(&base).unwrap()).unwrap();
+    let hidden = SimEffect::hidden(EffectKind::DeadTime, 1.0);
+    let est = sim_csvs(&d, "trial", Some(hidden), &[1, 2, 3]);
+    let val = sim_csvs(&d, "check", Some(hidden), &[11, 12]);
+    let s = |p: &Path| p.display().to_string();
+    let (out, json, ship) = (
+        d.join("aug.postcard"),
+        d.join("aug-summary.json"),
+        d.join("ship.toml"),
+    );
+    let o = run(&[
+        "augment",
+        "--model",
+        &s(&model),
+        "--effect",
+        "dead-time",
+        "--data",
+        &s(&est[0]),
+        "--data",
+        &s(&est[1]),
+        "--data",
+        &s(&est[2]),
+        "--validate",
+        &s(&val[0]),
+        "--validate",
+        &s(&val[1]),
+        "--out",
+        &s(&out),
+        "--json",
+        &s(&json),
+        "--ship",
+        &s(&ship),
+        "--seed",
+        "3",
+    ]);
+    assert_eq!(code(&o), 0, "{}\n{}", stdout(&o), stderr(&o));
+    assert!(
+        stdout(&o).contains("dead time of 2 samples"),
+        "{}",
+        stdout(&o)
+    );
+    assert!(
+        stdout(&o).contains("a dead time of 2.0 s"),
+        "{}",
+        stdout(&o)
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["effect"], "dead-time");
+    assert_eq!(v["kept"], true);
+    for k in ["1", "5", "10", "20", "sim"] {
+        assert!(v["before"]["fit"][k].is_number(), "{k}");
+        assert!(v["after"]["fit"][k].is_number(), "{k}");
+    }
+    let (b10, a10) = (
+        v["before"]["fit"]["10"].as_f64().unwrap(),
+        v["after"]["fit"]["10"].as_f64().unwrap(),
+    );
+    assert!(a10 > b10 + 10.0, "{b10} → {a10}");
+    assert!(v["fit_gain_pp"].as_f64().unwrap() > 0.0);
+    assert!(v["delta_aic"].as_f64().unwrap() < 0.0);
+    assert!(v["delta_bic"].as_f64().unwrap() < 0.0);
+    assert!(v["explanation"].as_str().unwrap().contains("Kept"));
+    assert_eq!(v["ship"], s(&ship));
+    // the blob decodes to the model with the dead time; the twin sits beside it
+    let blob = std::fs::read(&out).unwrap();
+    let spec = yawcast_shared::blob::decode_blob(&blob).unwrap();
+    let m = yawcast::model::Model::from_spec(&spec).unwrap();
+    assert_eq!(
+        m.effect(EffectKind::DeadTime),
+        Some(&yawcast::model::Effect::DeadTime { samples: 2 })
+    );
+    assert!(d.join("aug.json").exists());
+    let ship_back = yawcast::sim::Ship::from_file(&ship).unwrap();
+    assert_eq!(ship_back.effects(), &[SimEffect::DeadTime { delay_s: 2.0 }]);
+
+    // the augmented model carries the effect: adding it again is bad input
+    let o = run(&[
+        "augment",
+        "--model",
+        &s(&out),
+        "--effect",
+        "dead-time",
+        "--data",
+        &s(&est[0]),
+        "--out",
+        &s(&d.join("again")),
+    ]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("already carries the effect `dead-time`"),
+        "{}",
+        stderr(&o)
+    );
+    // an unknown effect lists the valid names
+    let o = run(&[
+        "augment",
+        "--model",
+        &s(&model),
+        "--effect",
+        "waves",
+        "--data",
+        &s(&est[0]),
+        "--out",
+        &s(&d.join("x")),
+    ]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("unknown effect `waves`"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(stderr(&o).contains("nonlinear-damping"), "{}", stderr(&o));
+    assert!(!d.join("x.postcard").exists());
+}

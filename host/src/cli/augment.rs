@@ -152,7 +152,10 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
     let seed = args.seed.resolve();
     let (kind, auto) = match kind {
         Some(k) => (k, false),
-        None => (choose_auto(&model, &reference, &est, &val, seed)?, true),
+        None => match choose_auto(&model, &reference, &est, &val, seed)? {
+            Some(k) => (k, true),
+            None => return write_unchanged(args, &model, &est, &val),
+        },
     };
     let cfg = AugmentConfig::default();
     let t0 = std::time::Instant::now();
@@ -225,18 +228,59 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
     })
 }
 
-/// `--effect auto`: the verdict of the diagnosis.
+/// `--effect auto` with the verdict `none`: the input model is written unchanged.
+fn write_unchanged(
+    args: &AugmentArgs,
+    model: &Model,
+    est: &[Record],
+    val: &[Record],
+) -> Result<()> {
+    let check = val
+        .first()
+        .or(est.first())
+        .context("no record to check the export on")?;
+    let ex = export::export(model, &args.out, check)
+        .with_context(|| format!("writing the model {}", args.out.display()))?;
+    println!(
+        "no effect to add: the input model is written unchanged to {}",
+        ex.blob_path.display()
+    );
+    if let Some(p) = &args.ship {
+        println!("ship file {} left unchanged", p.display());
+    }
+    args.json.write(&serde_json::json!({
+        "command": "augment",
+        "effect": "none",
+        "auto": true,
+        "kept": false,
+        "before": serde_json::Value::Null,
+        "after": serde_json::Value::Null,
+        "fit_gain_pp": 0.0,
+        "delta_aic": serde_json::Value::Null,
+        "delta_bic": serde_json::Value::Null,
+        "explanation": "diagnose found no missing effect; the model is kept as it is",
+        "out": ex.blob_path,
+        "ship": serde_json::Value::Null,
+    }))
+}
+
+/// `--effect auto`: the verdict of `diagnose` (`None` for `none`), printed with its reasons.
 fn choose_auto(
-    _model: &Model,
-    _reference: &[Record],
-    _est: &[Record],
-    _val: &[Record],
-    _seed: u64,
-) -> Result<EffectKind> {
-    Err(bad(
-        "--effect auto needs `yawcast diagnose`, which is not available in this build; \
-         name the effect",
-    ))
+    model: &Model,
+    reference: &[Record],
+    est: &[Record],
+    val: &[Record],
+    seed: u64,
+) -> Result<Option<EffectKind>> {
+    let cfg = yawcast::diagnose::DiagnoseConfig {
+        seed,
+        // the refit below confirms the verdict
+        confirm: false,
+        ..Default::default()
+    };
+    let d = yawcast::diagnose::diagnose(model, reference, est, val, &cfg).map_err(bad)?;
+    println!("diagnose: verdict {}: {}", d.verdict, d.explanation);
+    Ok(d.verdict_kind())
 }
 
 /// Reads (or creates from the built-in ship) the ship file, adds the effect in physical
