@@ -8,6 +8,9 @@
 
 use std::collections::BTreeMap;
 
+mod run;
+pub use run::{hidden_kind, run, DemoConfig, DemoError};
+
 use serde::Serialize;
 
 use crate::data::Record;
