@@ -4,7 +4,8 @@
 #   bench/host/run.sh           PEM (2 000 samples, order 4; against N = 500…8000), one GA
 #                               generation, the full GA run (15 + 15 records × 1 800 samples,
 #                               50 generations) and the GA against trials and record length
-#   bench/host/run.sh --quick   PEM and one GA generation only (short measurement times)
+#                               and the simulator, diagnose and augment on 3 + 3 records
+#   bench/host/run.sh --quick   the same with short measurement times
 #
 # Prints one line per figure; criterion's own reports land in target/criterion/.
 set -euo pipefail
@@ -39,9 +40,10 @@ summarise() {
             split(line, v, " ")
             printf "%-40s %s %s  (%s %s … %s %s)\n", name, v[3], v[4], v[1], v[2], v[5], v[6]
         }
-        /^pem n=4|^GA / { print }
+        /^pem n=4|^GA |^diagnose verdict/ { print }
     '
 }
 
 cargo bench -p yawcast --bench pem -- "${times[@]}" 2>&1 | summarise
 YAWCAST_BENCH_FULL=$full cargo bench -p yawcast --bench ga -- "${times[@]}" 2>&1 | summarise
+cargo bench -p yawcast --bench diagnose -- "${times[@]}" 2>&1 | summarise

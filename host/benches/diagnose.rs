@@ -1,0 +1,68 @@
+//! Criterion benchmarks of the simulator (one 1 800-sample record), `diagnose` on 3 + 3
+//! records of 1 800 samples (with and without the confirming refit) and `augment` with a
+//! dead time.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use yawcast::augment::{self, AugmentConfig};
+use yawcast::diagnose::{self, DiagnoseConfig};
+use yawcast::pem::{self, PemConfig};
+use yawcast::sim::{self, NoiseSpec, Scenario, Ship, SimEffect};
+use yawcast_shared::model::EffectKind;
+
+fn scenario(effects: Vec<SimEffect>) -> Scenario {
+    Scenario {
+        noise: NoiseSpec {
+            gyro_std_degps: 0.03,
+            heading_std_deg: 0.1,
+            speed_std_mps: 0.01,
+        },
+        effects,
+        ..Scenario::default()
+    }
+}
+
+fn bench(c: &mut Criterion) {
+    let ship = Ship::default_lng();
+    let clean = scenario(Vec::new());
+    let trial = scenario(vec![SimEffect::hidden(EffectKind::DeadTime, 1.0)]);
+    c.bench_function("sim/record_1800", |b| {
+        b.iter(|| sim::simulate(&ship, &clean, 1).unwrap())
+    });
+    let reference = sim::simulate_many(&ship, &clean, &[1, 2, 3]).unwrap();
+    let est = sim::simulate_many(&ship, &trial, &[11, 12, 13]).unwrap();
+    let val = sim::simulate_many(&ship, &trial, &[21]).unwrap();
+    let model = pem::identify(&reference, None, &PemConfig::default())
+        .unwrap()
+        .model;
+    let cfg = DiagnoseConfig::default();
+    let d = diagnose::diagnose(&model, &reference, &est, &val, &cfg).unwrap();
+    eprintln!("diagnose verdict on a 2 s dead time: {}", d.verdict);
+    let mut g = c.benchmark_group("diagnose");
+    g.sample_size(10);
+    g.bench_function("ref3_trials3_N1800", |b| {
+        b.iter(|| diagnose::diagnose(&model, &reference, &est, &val, &cfg).unwrap())
+    });
+    let quick = DiagnoseConfig {
+        confirm: false,
+        ..DiagnoseConfig::default()
+    };
+    g.bench_function("ref3_trials3_N1800_no_confirm", |b| {
+        b.iter(|| diagnose::diagnose(&model, &reference, &est, &val, &quick).unwrap())
+    });
+    g.bench_function("augment_dead_time_trials3_N1800", |b| {
+        b.iter(|| {
+            augment::augment(
+                &model,
+                EffectKind::DeadTime,
+                &est,
+                &val,
+                &AugmentConfig::default(),
+            )
+            .unwrap()
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
