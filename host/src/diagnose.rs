@@ -32,9 +32,15 @@
 //!   effects the yaw prediction cannot see well, when its own channel shows it (heading for
 //!   a gyro bias, speed over ground for current and wind). The verdict's effect is then
 //!   refitted with the model ([`crate::augment::augment`]) for the before/after fits.
-//! - **Current or wind.** When speed over ground depends on heading, a current moves the ship
-//!   at once (kinematics) while wind acts through the surge dynamics: the lag with which
-//!   heading harmonics explain speed over ground best decides between the two.
+//! - **Current or wind.** A uniform current carries the ship: speed over ground varies with
+//!   heading by the current's speed (first harmonic), but the hull sees the same water
+//!   whatever its heading, so the current adds (almost) no heading-dependent yaw moment. Wind
+//!   turns the ship through the relative wind angle (first and second harmonics of the yaw
+//!   moment) and changes speed over ground only through added drag. "Wind" therefore nests
+//!   "current" (both leave the speed harmonics free; wind adds the yaw-moment harmonics), and
+//!   the likelihood-ratio test between them is the yaw channel's heading-harmonic statistic
+//!   against its bootstrap null: when speed over ground is logged and either is significant,
+//!   a yaw moment at level α names wind, none names current.
 //!
 //! Effects already in the model are skipped, so diagnosing an augmented model looks for the
 //! next one.
@@ -611,76 +617,36 @@ fn block_len(n: usize) -> usize {
 /// intercept per record and low-passed r² and δ² (speed lost in turns and to pod drag).
 /// `shift[i]` circularly shifts record i's heading against its speed (0: aligned).
 fn sog_harmonics(recs: &[Record], shift: &[usize]) -> Option<DVector<f64>> {
-    sog_fit(recs, shift, 0.0).map(|(b, _)| b)
-}
-
-/// The harmonic regression with the heading harmonics low-passed with time constant `lag_s`
-/// (0: instantaneous): (harmonic coefficients, residual sum of squares).
-fn sog_fit(recs: &[Record], shift: &[usize], lag_s: f64) -> Option<(DVector<f64>, f64)> {
     let nr = recs.len();
     let p = nr + 6;
     let mut xtx = DMatrix::<f64>::zeros(p, p);
     let mut xty = DVector::<f64>::zeros(p);
-    let mut yy = 0.0;
     let mut x = DVector::<f64>::zeros(p);
     for (i, r) in recs.iter().enumerate() {
         let psi = r.psi.as_ref()?;
         let sp = r.speed.as_ref()?;
         let a = (r.ts / SOG_TAU_S).min(1.0);
-        let al = if lag_s > 0.0 {
-            (r.ts / lag_s).min(1.0)
-        } else {
-            1.0
-        };
         let (mut lr, mut lu) = (0.0, 0.0);
         let n = r.len();
         let sh = shift.get(i).copied().unwrap_or(0) % n.max(1);
-        let mut hf = [0.0; 4];
         for t in 0..n {
             lr += a * (r.y[t] * r.y[t] - lr);
             lu += a * (r.u[t] * r.u[t] - lu);
             let ph = psi[(t + sh) % n].to_radians();
             let h = [ph.sin(), ph.cos(), (2.0 * ph).sin(), (2.0 * ph).cos()];
-            for j in 0..4 {
-                hf[j] = if t == 0 {
-                    h[j]
-                } else {
-                    hf[j] + al * (h[j] - hf[j])
-                };
-            }
             x.fill(0.0);
             x[i] = 1.0;
-            for j in 0..4 {
-                x[nr + j] = hf[j];
+            for (j, hj) in h.iter().enumerate() {
+                x[nr + j] = *hj;
             }
             x[nr + 4] = lr;
             x[nr + 5] = lu;
             xtx.ger(1.0, &x, &x, 1.0);
             xty.axpy(sp[t], &x, 1.0);
-            yy += sp[t] * sp[t];
         }
     }
     let beta = xtx.cholesky()?.solve(&xty);
-    let rss = (yy - beta.dot(&xty)).max(0.0);
-    Some((beta.rows(nr, 4).into_owned(), rss))
-}
-
-/// Lags (s) tried for the response of speed over ground to heading: 0 is the kinematic
-/// response of a current (the water carries the ship at once), the others the dynamic
-/// response of the surge motion to a force (wind).
-const SOG_LAGS_S: [f64; 6] = [0.0, 5.0, 10.0, 20.0, 40.0, 80.0];
-
-/// The lag (s) of [`SOG_LAGS_S`] with which heading harmonics explain speed over ground best
-/// (equal parameter counts, so the smallest residual wins).
-fn sog_best_lag(recs: &[Record]) -> Option<f64> {
-    let mut best = (f64::INFINITY, 0.0);
-    for &l in &SOG_LAGS_S {
-        let (_, rss) = sog_fit(recs, &[], l)?;
-        if rss < best.0 {
-            best = (rss, l);
-        }
-    }
-    Some(best.1)
+    Some(beta.rows(nr, 4).into_owned())
 }
 
 /// Time constant of the low-pass nuisance regressors of speed over ground (s).
@@ -728,7 +694,6 @@ fn wald(d: &DVector<f64>, v: &DMatrix<f64>, idx: &[usize]) -> f64 {
 /// direction deg the speed gain points to).
 #[derive(Debug, Clone, Copy)]
 struct SogEvidence {
-    lag_s: f64,
     chi1: f64,
     chi2: f64,
     amp1: f64,
@@ -748,7 +713,6 @@ fn sog_evidence(trial: &[Record], reference: &[Record], seed: u64) -> Option<Sog
         (t - r, vt + vr)
     };
     Some(SogEvidence {
-        lag_s: sog_best_lag(trial)?,
         chi1: wald(&d, &v, &[0, 1]),
         chi2: wald(&d, &v, &[2, 3]),
         amp1: d[0].hypot(d[1]),
@@ -773,6 +737,8 @@ struct Evidence {
     null: Null,
     best: Effect,
     p: f64,
+    /// p-value of the yaw channel alone (before any other channel is combined in).
+    p_yaw: f64,
     score: f64,
     statistic: f64,
     words: String,
@@ -894,7 +860,16 @@ pub fn diagnose(
                 .unwrap_or(std::cmp::Ordering::Equal),
         )
     });
-    encompass(model, &trial, &mut ev, level, cfg.alpha, cfg.parallel, sog);
+    current_or_wind(&mut ev, level, cfg.alpha, sog.is_some());
+    encompass(
+        model,
+        &trial,
+        &mut ev,
+        level,
+        cfg.alpha,
+        cfg.parallel,
+        sog.is_some(),
+    );
 
     // materiality: the effect's own held-out contribution (θ frozen, the effect's gains
     // refitted on the estimation part), best first; the verdict's effect is then refitted
@@ -1186,6 +1161,7 @@ fn effect_evidence(
         null,
         best,
         p: p_yaw,
+        p_yaw,
         score: null.excess(d),
         statistic: d,
         words: String::new(),
@@ -1313,6 +1289,52 @@ fn effect_evidence(
     ev
 }
 
+/// Current or wind, when speed over ground is logged (module docs): a uniform current carries
+/// the ship without a heading-dependent yaw moment, wind turns it. "Wind" nests "current"
+/// (the speed harmonics are free in both; wind adds the yaw-moment harmonics), so the
+/// likelihood-ratio test between them is the yaw channel's heading-harmonic statistic against
+/// its bootstrap null — first harmonic (current's regressors) or first and second (wind's),
+/// Bonferroni over the two, one test at level α. When either effect is significant, the one
+/// this test names is ranked ahead of the other; wind named this way is significant when
+/// both the heading dependence (the better of the two effects' p-values) and the yaw moment
+/// are (intersection–union: the larger p-value), and material when the speed channel shows
+/// the heading dependence.
+fn current_or_wind(ev: &mut Vec<Evidence>, level: f64, alpha: f64, speed: bool) {
+    let pos = |ev: &[Evidence], k: EffectKind| ev.iter().position(|e| e.kind == k);
+    let (Some(ic), Some(iw)) = (pos(ev, EffectKind::Current), pos(ev, EffectKind::Wind)) else {
+        return;
+    };
+    if !speed || (ev[ic].p >= level && ev[iw].p >= level) {
+        return;
+    }
+    let p_moment = (2.0 * ev[ic].p_yaw.min(ev[iw].p_yaw)).min(1.0);
+    let wind = p_moment < alpha;
+    let words = format!(
+        "; yaw moment varying with heading: p {} ({}): {}",
+        fmt_p(p_moment),
+        if wind { "present" } else { "absent" },
+        if wind {
+            "the ship is turned by it, wind (a current carries the ship without turning it)"
+        } else {
+            "speed over ground alone depends on heading, the water carries the ship: a current"
+        }
+    );
+    ev[ic].words.push_str(&words);
+    ev[iw].words.push_str(&words);
+    if wind {
+        let heading_p = ev[ic].p.min(ev[iw].p);
+        let cm = ev[ic].channel_material;
+        let w = &mut ev[iw];
+        w.p = w.p.min(heading_p.max(p_moment));
+        w.channel_material |= cm;
+    }
+    let (win, lose) = if wind { (iw, ic) } else { (ic, iw) };
+    if win > lose {
+        let e = ev.remove(win);
+        ev.insert(lose, e);
+    }
+}
+
 /// Encompassing test between the top two significant effects of the same horizon class:
 /// both fitted jointly; what does each add given the other? The one that adds nothing
 /// significant given the other is explained by it (and, when neither adds anything, the
@@ -1324,45 +1346,15 @@ fn encompass(
     level: f64,
     alpha: f64,
     par: bool,
-    sog: Option<SogEvidence>,
+    speed: bool,
 ) {
     if ev.len() < 2 || ev[1].p >= level {
         return;
     }
-    // current vs wind, both shown by speed over ground: a current moves the ship at once
-    // (kinematic), wind through the surge dynamics (lagged)
+    // current vs wind with speed over ground logged: decided by `current_or_wind`
     let pair = [ev[0].kind, ev[1].kind];
-    if let Some(s) = sog {
-        // speed over ground shows a heading dependence (one test at level α)
-        let shows = chi2_sf(s.chi1 + s.chi2, 4.0) < alpha;
-        if shows && pair.contains(&EffectKind::Current) && pair.contains(&EffectKind::Wind) {
-            let want = if s.lag_s == 0.0 {
-                EffectKind::Current
-            } else {
-                EffectKind::Wind
-            };
-            let w = format!(
-                "; speed over ground follows heading {} (best lag {:.0} s of {:?} s tried): {}",
-                if s.lag_s == 0.0 {
-                    "at once"
-                } else {
-                    "with a lag"
-                },
-                s.lag_s,
-                SOG_LAGS_S,
-                if s.lag_s == 0.0 {
-                    "the water carries the ship, a current"
-                } else {
-                    "a force acting through the surge dynamics, wind"
-                }
-            );
-            ev[0].words.push_str(&w);
-            ev[1].words.push_str(&w);
-            if ev[1].kind == want {
-                ev.swap(0, 1);
-            }
-            return;
-        }
+    if speed && pair.contains(&EffectKind::Current) && pair.contains(&EffectKind::Wind) {
+        return;
     }
     if ev[0].channel_material != ev[1].channel_material {
         return;
@@ -1618,27 +1610,12 @@ mod tests {
             full.len(),
             t.elapsed().as_secs_f64()
         );
-        // Every effect named at full strength — except that one wind trial in three may read
-        // as a current: a 3 m/s wind on this hull moves the yaw moment mostly at the first
-        // heading harmonic and speed over ground by only ±0.03–0.05 m/s with no clear lag, so
-        // neither channel separates it from a weak current (a known limit, reported).
-        let wrong_other = full_out
-            .iter()
-            .filter(|o| o.0 != o.1 && o.0 != Some(EffectKind::Wind))
-            .count();
-        let wind_right = full_out
-            .iter()
-            .filter(|o| o.0 == Some(EffectKind::Wind) && o.1 == o.0)
-            .count();
+        // every effect named at full strength
         assert_eq!(
-            wrong_other,
-            0,
+            right_full,
+            full.len(),
             "full strength: {right_full} of {}",
             full.len()
-        );
-        assert!(
-            wind_right >= 2,
-            "full strength: wind named in {wind_right} of 3"
         );
         assert!(right_null >= 19, "verdict none in {right_null} of 20");
         assert!(
@@ -1677,8 +1654,6 @@ mod tests {
             (s.amp1 - crate::sim::HIDDEN_CURRENT_MPS).abs() < 0.1,
             "{s:?}"
         );
-        // the water carries the ship at once: no lag
-        assert_eq!(s.lag_s, 0.0, "{s:?}");
         assert!((s.dir1 - 90.0).abs() < 10.0, "{s:?}");
         assert!(chi2_sf(s.chi1, 2.0) < 1e-6, "{s:?}");
         let n = sog_evidence(&records(None, &[11, 12]), &clean, 3).unwrap();
@@ -1815,5 +1790,60 @@ mod tests {
         let d = diagnose(&with, &refs, &f, &[], &cfg).unwrap();
         assert!(d.ranking.iter().all(|r| r.effect != "dead-time"));
         assert!(d.reference_used);
+    }
+
+    fn evidence(kind: EffectKind, p: f64, p_yaw: f64, channel_material: bool) -> Evidence {
+        Evidence {
+            kind,
+            h: SLOW_HORIZON,
+            null: Null { c: 1.0, nu: 2.0 },
+            best: Effect::zero(kind, 0.0),
+            p,
+            p_yaw,
+            score: 0.0,
+            statistic: 0.0,
+            words: String::new(),
+            parameter: None,
+            channel_material,
+        }
+    }
+
+    #[test]
+    fn a_yaw_moment_names_wind_its_absence_a_current() {
+        let (level, alpha) = (0.01 / 9.0, 0.01);
+        let kinds = |ev: &[Evidence]| ev.iter().map(|e| e.kind).collect::<Vec<_>>();
+        // speed over ground shows the heading dependence (current first), and the yaw
+        // channel a moment: wind goes ahead, significant and material through the speed channel
+        let mut ev = vec![
+            evidence(EffectKind::Current, 1e-7, 8e-3, true),
+            evidence(EffectKind::Bias, 1e-4, 1e-4, false),
+            evidence(EffectKind::Wind, 2e-3, 4e-4, false),
+        ];
+        current_or_wind(&mut ev, level, alpha, true);
+        assert_eq!(
+            kinds(&ev),
+            [EffectKind::Wind, EffectKind::Current, EffectKind::Bias]
+        );
+        assert!((ev[0].p - 8e-4).abs() < 1e-15, "{}", ev[0].p);
+        assert!(ev[0].channel_material);
+        assert!(ev[0].words.contains("present"), "{}", ev[0].words);
+        // the same speed evidence without a yaw moment: a current, wind moved behind it
+        let mut ev = vec![
+            evidence(EffectKind::Wind, 1e-6, 0.3, true),
+            evidence(EffectKind::Current, 1e-7, 0.05, true),
+        ];
+        current_or_wind(&mut ev, level, alpha, true);
+        assert_eq!(kinds(&ev), [EffectKind::Current, EffectKind::Wind]);
+        assert_eq!(ev[1].p, 1e-6);
+        // without speed over ground, or with neither significant, nothing changes
+        for (speed, p) in [(false, 1e-7), (true, 0.5)] {
+            let mut ev = vec![
+                evidence(EffectKind::Current, p, 1e-9, true),
+                evidence(EffectKind::Wind, p, 1e-9, true),
+            ];
+            current_or_wind(&mut ev, level, alpha, speed);
+            assert_eq!(kinds(&ev), [EffectKind::Current, EffectKind::Wind]);
+            assert_eq!(ev[1].p, p);
+        }
     }
 }
