@@ -17,7 +17,7 @@ need_bin=1
 smoke=0
 for a in "$@"; do
     case "$a" in
-        --standin|--help|-h|selftest|fit) need_bin=0 ;;
+        --standin|--help|-h|selftest|fit|report) need_bin=0 ;;
         --smoke) smoke=1 ;;
     esac
 done
