@@ -535,6 +535,8 @@ fn identify_average_export_compare_chain() {
         assert!(v.get(k).is_some(), "identify JSON lacks `{k}`");
     }
     assert!(v["fit"]["5"].as_f64().unwrap() > 95.0, "{v}");
+    let secs = v["identify_s"].as_f64().unwrap();
+    assert!(secs > 0.0 && secs < 60.0, "{v}");
 
     let o = run(&[
         "average",

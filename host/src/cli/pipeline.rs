@@ -146,6 +146,8 @@ pub struct IdentifySummary {
     pub fit: BTreeMap<String, f64>,
     /// Model files written.
     pub model: Option<String>,
+    /// Wall-clock seconds of the identification itself (reading and writing excluded).
+    pub identify_s: f64,
 }
 
 /// Runs `identify`.
@@ -203,7 +205,9 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
             "orders": lines,
         }));
     }
+    let started = std::time::Instant::now();
     let rep = pem::identify(&recs, None, &cfg).map_err(input_ident)?;
+    let identify_s = started.elapsed().as_secs_f64();
     println!(
         "identified order {} on {} record(s), {} samples: {} after {} iterations; paper's rule: {:?}",
         rep.model.n,
@@ -255,6 +259,7 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
         fit_identification: rep.fit.clone(),
         fit,
         model: written,
+        identify_s,
     })
 }
 
