@@ -1,7 +1,6 @@
 //! `yawcast augment`: add a library effect to a model, re-identify it, compare held-out fits
 //! before and after, export the result, and optionally write the effect into a ship file.
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
@@ -9,6 +8,7 @@ use clap::Args;
 use serde::Serialize;
 use yawcast::augment::{self, AugmentConfig, AugmentError, AugmentReport};
 use yawcast::data::Record;
+use yawcast::demo::FitSummary;
 use yawcast::export;
 use yawcast::model::Model;
 use yawcast::sim::{Ship, SimEffect};
@@ -52,13 +52,6 @@ pub struct AugmentArgs {
     pub read: ReadArgs,
 }
 
-/// Fits of one model, keyed by horizon.
-#[derive(Debug, Serialize)]
-pub struct Fits {
-    /// Held-out fit % keyed by horizon ("1", "5", "10", "20", "sim").
-    pub fit: BTreeMap<String, f64>,
-}
-
 /// The JSON summary of `augment`.
 #[derive(Debug, Serialize)]
 pub struct AugmentSummary {
@@ -71,11 +64,11 @@ pub struct AugmentSummary {
     /// Whether it was kept.
     pub kept: bool,
     /// The input model on the held-out records.
-    pub before: Fits,
+    pub before: FitSummary,
     /// The input structure re-identified on the estimation records.
-    pub baseline: Fits,
+    pub baseline: FitSummary,
     /// The augmented model.
-    pub after: Fits,
+    pub after: FitSummary,
     /// after − baseline at 10 steps (pp).
     pub fit_gain_pp: f64,
     /// ΔAIC candidate − baseline.
@@ -205,13 +198,13 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
         effect: kind.name().to_string(),
         auto,
         kept: rep.kept,
-        before: Fits {
+        before: FitSummary {
             fit: rep.before.clone(),
         },
-        baseline: Fits {
+        baseline: FitSummary {
             fit: rep.baseline.clone(),
         },
-        after: Fits {
+        after: FitSummary {
             fit: rep.after.clone(),
         },
         fit_gain_pp: rep.fit_gain_pp,

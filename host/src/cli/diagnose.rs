@@ -8,6 +8,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use serde::Serialize;
 use yawcast::data::Record;
+use yawcast::demo::FitSummary;
 use yawcast::diagnose::{diagnose, DiagnoseConfig, Diagnosis, Ranked};
 use yawcast::model::Model;
 
@@ -50,13 +51,6 @@ pub struct DiagnoseArgs {
     pub read: ReadArgs,
 }
 
-/// Fits keyed by horizon, as `{"fit": {"1": …, "sim": …}}`.
-#[derive(Debug, Serialize)]
-pub struct Fits {
-    /// Fit % keyed by horizon ("1", "5", "10", "20", "sim").
-    pub fit: BTreeMap<String, f64>,
-}
-
 /// The JSON summary of `diagnose` (stable field names).
 #[derive(Debug, Serialize)]
 pub struct DiagnoseSummary {
@@ -71,9 +65,9 @@ pub struct DiagnoseSummary {
     /// Every effect not already in the model, best first.
     pub ranking: Vec<Ranked>,
     /// Held-out fits of the model.
-    pub before: Fits,
+    pub before: FitSummary,
     /// Held-out fits with the verdict's effect.
-    pub after: Fits,
+    pub after: FitSummary,
     /// Whether reference records were used.
     pub reference_used: bool,
     /// The verdict in words.
@@ -124,10 +118,10 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
         model: args.model.display().to_string(),
         verdict: d.verdict.clone(),
         ranking: d.ranking.clone(),
-        before: Fits {
+        before: FitSummary {
             fit: d.before.clone(),
         },
-        after: Fits {
+        after: FitSummary {
             fit: d.after.clone(),
         },
         reference_used: d.reference_used,
