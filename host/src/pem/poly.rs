@@ -87,10 +87,15 @@ pub(crate) fn roots_within(p: &[f64], n: usize, radius: f64) -> bool {
 }
 
 /// Whether A and A − KC of the canonical model (a, k) have every eigenvalue inside
-/// [`MAX_RADIUS`].
+/// [`MAX_RADIUS`], and the model rounded to `f32` (what export writes and the firmware runs)
+/// still passes the shared crate's stability check.
+///
+/// The second test matters for a pole next to 1 (an offset or a slow drift the search models
+/// as a near-integrator): rounding `a` to `f32` moves such a root by ~1e-7 and can put it on or
+/// outside the unit circle, which would make a model the search accepted impossible to export.
 pub(crate) fn canonical_stable(a: &[f64], k: &[f64]) -> bool {
     let n = a.len();
-    if n == 0 || n > MAX_N {
+    if n == 0 || n > MAX_N || k.len() != n {
         return false;
     }
     let mut p = [0.0; MAX_N + 1];
@@ -99,7 +104,35 @@ pub(crate) fn canonical_stable(a: &[f64], k: &[f64]) -> bool {
         return false;
     }
     predictor_poly(a, k, &mut p);
-    roots_within(&p, n, MAX_RADIUS)
+    roots_within(&p, n, MAX_RADIUS) && f32_stable(a, k)
+}
+
+/// The shared crate's check (Schur–Cohn on the `f32` coefficients) on the rounded model.
+fn f32_stable(a: &[f64], k: &[f64]) -> bool {
+    use yawcast_shared::model::{ModelSpec, Units, MAX_ORDER};
+    let n = a.len();
+    if n > MAX_ORDER {
+        // beyond what the wire format carries; the f64 test above is all there is
+        return true;
+    }
+    let mut a32 = [0.0f32; MAX_ORDER];
+    let mut k32 = [0.0f32; MAX_ORDER];
+    for i in 0..n {
+        a32[i] = a[i] as f32;
+        k32[i] = k[i] as f32;
+    }
+    let b32 = [0.0f32; MAX_ORDER];
+    // n ≤ MAX_ORDER = 8, so the order fits in u8
+    ModelSpec::new(
+        n as u8,
+        1.0,
+        &a32[..n],
+        &b32[..n],
+        &k32[..n],
+        Units::default(),
+        &[],
+    )
+    .is_ok()
 }
 
 /// Roots of a polynomial (highest power first, leading coefficient non-zero).
@@ -286,6 +319,51 @@ mod tests {
         assert!(
             (p[1] - 0.3).abs() < 1e-12 && (p[2] + 0.2).abs() < 1e-12,
             "{p:?}"
+        );
+    }
+
+    #[test]
+    fn accepted_models_survive_rounding_to_f32() {
+        use yawcast_shared::model::{ModelSpec, Units};
+        // A near-integrator (the search's answer to an offset or a slow drift) next to three
+        // ordinary poles; K = 0, so A − KC = A and both checks see the same roots.
+        let k = [0.0; 4];
+        let (mut f64_only, mut rejected_for_f32) = (0, 0);
+        for i in 0..2000 {
+            let r = MAX_RADIUS - 1e-10 * f64::from(i);
+            let p = from_roots(&[
+                Complex::new(r, 0.0),
+                Complex::new(0.97, 0.0),
+                Complex::new(0.6, 0.2),
+                Complex::new(0.6, -0.2),
+            ]);
+            let a: Vec<f64> = (0..4).map(|j| -p[4 - j]).collect();
+            let mut q = [0.0; MAX_N + 1];
+            a_poly(&a, &mut q);
+            let mut f64_ok = roots_within(&q, 4, MAX_RADIUS);
+            predictor_poly(&a, &k, &mut q);
+            f64_ok &= roots_within(&q, 4, MAX_RADIUS);
+            let a32: Vec<f32> = a.iter().map(|&v| v as f32).collect();
+            let k32: Vec<f32> = k.iter().map(|&v| v as f32).collect();
+            let exportable =
+                ModelSpec::new(4, 1.0, &a32, &[0.0; 4], &k32, Units::default(), &[]).is_ok();
+            let accepted = canonical_stable(&a, &k);
+            // every model the search accepts can be exported
+            assert!(
+                !accepted || exportable,
+                "r = {r}: accepted but not exportable"
+            );
+            if f64_ok {
+                f64_only += 1;
+                if !accepted && !exportable {
+                    rejected_for_f32 += 1;
+                }
+            }
+        }
+        // the grid does reach the case the f32 test exists for
+        assert!(
+            f64_only > 0 && rejected_for_f32 > 0,
+            "{f64_only} {rejected_for_f32}"
         );
     }
 }
