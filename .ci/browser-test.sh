@@ -5,7 +5,8 @@
 #   bash .ci/browser-test.sh [RUN_DIR]
 #
 # RUN_DIR holds report.html (a `yawcast demo` run directory). Without it, the script runs
-# `yawcast demo --seed 1 --out runs/browser-test` first (release build).
+# `yawcast demo --seed 1 --out runs/browser-test` first (release build; YAWCAST_PROFILE=ci
+# builds with the `ci` profile instead, as .ci/run does).
 # Needs Debian's `chromium` (apt-get install -y --no-install-recommends chromium) and perl.
 # Leaves RUN_DIR/report.png (the screenshot) and RUN_DIR/report.dom.html (the rendered DOM).
 set -euo pipefail
@@ -14,7 +15,8 @@ cd "$(dirname "$0")/.."
 RUN_DIR=${1:-}
 if [ -z "$RUN_DIR" ]; then
     RUN_DIR=runs/browser-test
-    cargo run --release -q -p yawcast -- demo --seed 1 --out "$RUN_DIR" > /dev/null
+    cargo run --profile "${YAWCAST_PROFILE:-release}" -q -p yawcast -- demo --seed 1 \
+        --out "$RUN_DIR" > /dev/null
 fi
 RUN_DIR=$(cd "$RUN_DIR" && pwd)
 REPORT="$RUN_DIR/report.html"
