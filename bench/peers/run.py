@@ -1154,16 +1154,29 @@ def _finite(v):
 
 def run_case_yawcast(yc, case, mdir, rows, args, log_print):
     seed = args.seed
-    # plain PEM
+    # plain PEM, on the same mean-removed estimation record every peer sees (the operating point
+    # is added back when predicting, as for the peers)
     pem = mdir / "yawcast-pem.postcard"
     row = {"case": case.name, "effect": case.effect, "seed": case.seed, "tool": "yawcast-pem"}
     try:
-        wall, t_in, _ = yc.identify(case.est, pem, seed)
-        row.update(wall_s=wall, inproc_s=t_in, model=str(yc.twin(pem)))
+        est = read_record(case.est)
+        u0, y0 = _center(est)
+        centered = mdir / "est-centered.csv"
+        write_record(centered, Record(est.name, est.ts, est.u - u0, est.y - y0, est.psi))
+        wall, t_in, _ = yc.identify(centered, pem, seed)
+        row.update(wall_s=wall, inproc_s=t_in, model=str(yc.twin(pem)), u0=u0, y0=y0)
     except Exception as e:  # noqa: BLE001
         row.update(error=str(e))
     rows.append(row)
-    pem_ok = "error" not in row
+    # diagnose + augment start from a model of the raw record: the offsets are physics
+    # (bias, gyro bias, …) that diagnose is there to name
+    raw = mdir / "yawcast-pem-raw.postcard"
+    try:
+        yc.identify(case.est, raw, seed)
+        pem_ok = True
+    except Exception as e:  # noqa: BLE001
+        pem_ok = False
+        log_print(f"  yawcast identify on the raw record of {case.name} failed: {e}")
     # GA-tuned: the paper's recipe — PEM on the simulator's record, GA fitness on the trial record
     if not args.no_ga:
         ga = mdir / "yawcast-ga.postcard"
@@ -1179,15 +1192,15 @@ def run_case_yawcast(yc, case, mdir, rows, args, log_print):
         row = {"case": case.name, "effect": case.effect, "seed": case.seed, "tool": "yawcast-aug"}
         try:
             dj = mdir / "diagnose.json"
-            wall_d, ddoc = yc.diagnose(pem, case.est, case.ref, dj, seed)
+            wall_d, ddoc = yc.diagnose(raw, case.est, case.ref, dj, seed)
             verdict = _find(ddoc, "verdict", "effect", "best", "missing")
             if isinstance(verdict, str) and verdict in EFFECTS:
                 aug = mdir / "yawcast-aug.postcard"
-                wall_a, t_a, _ = yc.augment(pem, case.est, verdict, aug, seed)
+                wall_a, t_a, _ = yc.augment(raw, case.est, verdict, aug, seed)
                 row.update(model=str(yc.twin(aug)))
             else:
                 wall_a, t_a = 0.0, None
-                row.update(model=str(yc.twin(pem)))
+                row.update(model=str(yc.twin(raw)))
             row.update(verdict=verdict if isinstance(verdict, str) else "none", wall_s=wall_d + wall_a,
                        inproc_s=t_a)
         except Exception as e:  # noqa: BLE001
@@ -1205,12 +1218,21 @@ def score_rows(rows, cases_by_name, yc, work, log_print):
         case = cases_by_name[row["case"]]
         val = read_record(case.val)
         model = load_model(row["model"], row["tool"])
+        if "u0" in row:
+            # identified on the mean-removed record: the operating point goes back in
+            model.u0, model.y0 = float(row["u0"]), float(row["y0"])
         row["fits"] = score(model, val)
         # the yawcast tools' own numbers for the same model and record, as a cross-check
         if yc is not None and row["tool"].startswith("yawcast") and row["model"].endswith(".json"):
             try:
                 cj = Path(row["model"]).with_suffix(".compare.json")
-                doc = yc.compare(Path(row["model"]).with_suffix(".postcard"), case.val, cj)
+                vpath = case.val
+                if "u0" in row:
+                    # the same shift on the validation record; fit is unchanged by it
+                    vpath = Path(row["model"]).parent / "val-centered.csv"
+                    write_record(vpath, Record(val.name, val.ts, val.u - model.u0, val.y - model.y0,
+                                               val.psi))
+                doc = yc.compare(Path(row["model"]).with_suffix(".postcard"), vpath, cj)
                 theirs = _compare_fits(doc)
                 if theirs:
                     d = max(abs(theirs[h] - row["fits"][h]) for h in theirs if h in row["fits"])
@@ -1582,9 +1604,11 @@ def notes(meta, args):
         "predictions fed back; the first 4 samples are the recursion's initial condition. Its block-wise "
         "`steps_ahead` is not used. Our recursion reproduces sysidentpy's own one-step and free-run "
         "predictions to 1e-8 (`run.py selftest`).",
-        "- yawcast: `identify` (plain PEM, λ = 0) on the estimation record; `tune` (GA over λ, R, the paper's recipe: PEM on the clean simulator's record, fitness = k-step fit on the estimation record as the trial); `diagnose` "
+        "- yawcast: `identify` (plain PEM, λ = 0) on the same mean-removed estimation record the peers see "
+        "(operating point added back when predicting, as for them); `tune` (GA over λ, R, the paper's recipe: PEM on the clean simulator's record, fitness = k-step fit on the estimation record as the trial); `diagnose` "
         "against the clean simulator's record, then `augment` with the diagnosed effect (a model with no verdict "
-        "stays plain). Its models are read from the JSON twin (a, b, k and the effects) and scored by the same "
+        "stays plain); diagnose and augment start from plain PEM on the raw estimation record, since offsets are "
+        "physics (bias, gyro bias) they are there to name. Its models are read from the JSON twin (a, b, k and the effects) and scored by the same "
         "predictor, effects included (dead time → saturation → rate limit, bias, asymmetry, damping, heading "
         "terms, gyro bias), as `host/src/predict.rs` defines them.",
     ]
