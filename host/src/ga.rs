@@ -74,6 +74,13 @@ pub struct GaConfig {
     pub combine: Combine,
     /// STD% above which a candidate is rejected (paper: 10).
     pub std_limit: f64,
+    /// Candidate centres θ₀ of the penalty λ (θ − θ₀)ᵀ R (θ − θ₀) (`None`: θ₀ = 0, the
+    /// paper). With two or more, one GA runs per centre and the best fitness wins, so the
+    /// tuning chooses the prior that predicts the trials best — e.g. zero (shrinks the
+    /// dynamics, which can suit trials with actuator effects the simulator lacks) and the
+    /// model identified on all simulation records (keeps the simulator's dynamics and only
+    /// steadies the scattered parameters). Empty: `pem.nominal` is the one centre.
+    pub centres: Vec<Option<Vec<f64>>>,
     /// RNG seed.
     pub seed: u64,
     /// Settings of the inner identifications (λ and R are set by the GA).
@@ -101,6 +108,7 @@ impl Default for GaConfig {
             grouped: true,
             combine: Combine::Average,
             std_limit: pem::STD_PCT_UNRELIABLE,
+            centres: Vec::new(),
             seed: 0,
             pem: PemConfig {
                 max_iter: 40,
@@ -182,6 +190,8 @@ pub struct GaReport {
     pub lambda: f64,
     /// Its R diagonal (one weight per parameter, `Model::param_names` order).
     pub r: Vec<f64>,
+    /// Index into [`GaConfig::centres`] of the winning run's penalty centre (0 with one).
+    pub centre: usize,
     /// Its genes (codes).
     pub genes: Vec<u16>,
     /// Its fitness (mean k-step fit % on the trials).
@@ -290,21 +300,17 @@ impl Genome {
     fn new(base: &Model, grouped: bool) -> Genome {
         let n = base.n;
         let p = 3 * n + base.effect_gains().len();
-        if grouped {
+        let (r_gene, lambda_gene) = if grouped {
             let has_effects = p > 3 * n;
             let r_gene: Vec<usize> = (0..p).map(|i| if i < 3 * n { i / n } else { 3 }).collect();
-            let lambda_gene = if has_effects { 4 } else { 3 };
-            Genome {
-                r_gene,
-                lambda_gene,
-                len: lambda_gene + 1,
-            }
+            (r_gene, if has_effects { 4 } else { 3 })
         } else {
-            Genome {
-                r_gene: (0..p).collect(),
-                lambda_gene: p,
-                len: p + 1,
-            }
+            ((0..p).collect(), p)
+        };
+        Genome {
+            r_gene,
+            lambda_gene,
+            len: lambda_gene + 1,
         }
     }
 
@@ -380,13 +386,18 @@ fn trial_fits(model: &Model, trials: &[Record], horizons: &[usize]) -> BTreeMap<
 }
 
 impl Ctx<'_> {
-    /// Identifies with (λ, R) and scores the model; `std_limit` applies.
+    /// Identifies with (λ, R) around the run's penalty centre and scores the model;
+    /// `std_limit` applies.
     fn evaluate(&self, lambda: f64, r: &[f64]) -> Outcome {
-        let pc = PemConfig {
+        let mut pc = PemConfig {
             lambda,
             r: Some(r.to_vec()),
             ..self.cfg.pem.clone()
         };
+        // one run, one centre (tune_with splits several centres into runs)
+        if let Some(c) = self.cfg.centres.first() {
+            pc.nominal = c.clone();
+        }
         let (model, std) = match self.cfg.combine {
             Combine::Average => {
                 let mut reps = Vec::with_capacity(self.sim.len());
@@ -564,9 +575,56 @@ pub fn tune(
 
 /// [`tune`] with a callback after every generation instead of the progress bar.
 ///
+/// With two or more [`GaConfig::centres`], one GA runs per centre (same seed and settings)
+/// and the one with the best fitness wins; its [`GaReport::centre`] says which.
+///
 /// # Errors
-/// As [`tune`].
+/// As [`tune`]; with several centres, the first centre's error when every run fails.
 pub fn tune_with(
+    sim: &[Record],
+    trials: &[Record],
+    base: &Model,
+    cfg: &GaConfig,
+    on_generation: &mut dyn FnMut(&GenStats),
+) -> Result<GaReport, GaError> {
+    let p = 3 * base.n + base.effect_gains().len();
+    for (i, c) in cfg.centres.iter().enumerate() {
+        if let Some(v) = c {
+            if v.len() != p || v.iter().any(|x| !x.is_finite()) {
+                return Err(GaError::Config(format!(
+                    "penalty centre {i} has {} values (finite ones needed: {p}, one per parameter)",
+                    v.len()
+                )));
+            }
+        }
+    }
+    if cfg.centres.len() < 2 {
+        return tune_one(sim, trials, base, cfg, on_generation);
+    }
+    let mut best: Option<GaReport> = None;
+    let mut first_err = None;
+    for (i, c) in cfg.centres.iter().enumerate() {
+        let one = GaConfig {
+            centres: vec![c.clone()],
+            ..cfg.clone()
+        };
+        match tune_one(sim, trials, base, &one, on_generation) {
+            Ok(mut r) => {
+                r.centre = i;
+                if best.as_ref().map_or(true, |b| r.best_fit > b.best_fit) {
+                    best = Some(r);
+                }
+            }
+            Err(e) => {
+                first_err.get_or_insert(e);
+            }
+        }
+    }
+    best.ok_or_else(|| first_err.unwrap_or(GaError::NoSimulation))
+}
+
+/// One GA run around one penalty centre (`cfg.centres[0]`, else `cfg.pem.nominal`).
+fn tune_one(
     sim: &[Record],
     trials: &[Record],
     base: &Model,
@@ -713,6 +771,7 @@ pub fn tune_with(
         best_model: tuned.model.clone(),
         lambda,
         r,
+        centre: 0,
         genes,
         best_fit,
         tuned,
@@ -887,6 +946,23 @@ mod tests {
         assert_eq!(g.len, 13);
         let m = m.with_effect(Effect::Bias { beta: 0.0 });
         assert_eq!(Genome::new(&m, true).len, 5);
+    }
+
+    #[test]
+    fn a_centre_of_the_wrong_length_is_a_config_error() {
+        let (sim, trials) = scenario(2, 300);
+        let b = base(&sim);
+        let cfg = GaConfig {
+            max_generations: 1,
+            progress: false,
+            centres: vec![None, Some(vec![0.0; 5])],
+            ..GaConfig::default()
+        };
+        let e = tune(&sim, &trials, &b, &cfg).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "bad GA setting: penalty centre 1 has 5 values (finite ones needed: 12, one per parameter)"
+        );
     }
 
     #[test]

@@ -962,3 +962,80 @@ fn augment_adds_a_dead_time_exports_it_and_writes_the_ship() {
     assert!(stderr(&o).contains("nonlinear-damping"), "{}", stderr(&o));
     assert!(!d.join("x.postcard").exists());
 }
+
+#[test]
+fn tune_beats_conventional_on_dead_time_trials_and_pins_its_json() {
+    use yawcast::sim::SimEffect;
+    use yawcast_shared::model::EffectKind;
+    let d = scratch("tune");
+    let sims = sim_csvs(&d, "sim", None, &[401, 402, 403, 404]);
+    let trials = sim_csvs(
+        &d,
+        "trial",
+        Some(SimEffect::hidden(EffectKind::DeadTime, 1.0)),
+        &[501, 502, 503],
+    );
+    let json = d.join("tune.json");
+    let mut cmd = bin();
+    cmd.arg("tune");
+    for p in &sims {
+        cmd.arg("--data").arg(p);
+    }
+    for p in &trials {
+        cmd.arg("--validate").arg(p);
+    }
+    let o = cmd
+        .args(["--generations", "15", "--seed", "7", "--json"])
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(stdout(&o).contains("seed 7"), "{}", stdout(&o));
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(v["command"], "tune");
+    assert_eq!(v["seed"], 7);
+    assert!(["zero", "simulation"].contains(&v["centre"].as_str().unwrap()));
+    assert_eq!(v["r"].as_array().unwrap().len(), 12);
+    for k in ["5", "10"] {
+        let tuned = v["tuned"]["fit"][k].as_f64().unwrap();
+        let conv = v["conventional"]["fit"][k].as_f64().unwrap();
+        // the GA may always fall back to the conventional individual; here it must do better
+        assert!(
+            tuned > conv,
+            "{k} steps: tuned {tuned} vs conventional {conv}"
+        );
+    }
+    let worst = v["tuned"]["std_pct"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s.as_f64().unwrap())
+        .fold(0.0, f64::max);
+    assert!(worst <= 10.0, "tuned STD% {worst}");
+    // the paper's centre alone is still there
+    let o = {
+        let mut c = bin();
+        c.arg("tune");
+        for p in &sims {
+            c.arg("--data").arg(p);
+        }
+        c.arg("--validate")
+            .arg(&trials[0])
+            .args([
+                "--generations",
+                "3",
+                "--centre",
+                "zero",
+                "--seed",
+                "7",
+                "--json",
+            ])
+            .arg(d.join("zero.json"))
+            .output()
+            .unwrap()
+    };
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let z: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("zero.json")).unwrap()).unwrap();
+    assert_eq!(z["centre"], "zero");
+}

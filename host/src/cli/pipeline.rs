@@ -283,6 +283,17 @@ pub enum Genes {
     PerParameter,
 }
 
+/// Centre θ₀ of the GA's penalty λ (θ − θ₀)ᵀ R (θ − θ₀).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Centre {
+    /// θ₀ = 0 (the paper).
+    Zero,
+    /// θ₀ = the model identified on all `--data` records together (the simulator's prior).
+    Simulation,
+    /// Both: an extra gene lets the GA choose the one that predicts the trials best.
+    Both,
+}
+
 /// Arguments of `yawcast tune`.
 #[derive(Debug, Args)]
 pub struct TuneArgs {
@@ -298,6 +309,9 @@ pub struct TuneArgs {
     /// Gene layout.
     #[arg(long, value_enum, default_value = "grouped")]
     pub genes: Genes,
+    /// Centre of the penalty λ (θ − θ₀)ᵀ R (θ − θ₀).
+    #[arg(long, value_enum, default_value = "both")]
+    pub centre: Centre,
     /// Decode genes on a log scale (the paper: linear).
     #[arg(long)]
     pub log_scale: bool,
@@ -364,6 +378,21 @@ pub fn tune(args: &TuneArgs) -> Result<()> {
         .map_err(input_ident)
         .context("the starting model")?
         .model;
+    let mut cfg = cfg;
+    if args.centre != Centre::Zero {
+        let all = pem::identify(&sim, None, &base_cfg)
+            .map_err(input_ident)
+            .context("the model of all --data records (the penalty centre)")?
+            .model;
+        cfg.centres = match args.centre {
+            Centre::Simulation => vec![Some(all.theta())],
+            _ => vec![None, Some(all.theta())],
+        };
+    }
+    let centre_name = |i: usize| match (args.centre, i) {
+        (Centre::Zero, _) | (Centre::Both, 0) => "zero",
+        _ => "simulation",
+    };
     let rep = ga::tune(&sim, &trials, &base, &cfg).map_err(|e| match e {
         ga::GaError::NoSimulation
         | ga::GaError::NoTrials
@@ -375,7 +404,12 @@ pub fn tune(args: &TuneArgs) -> Result<()> {
         "GA: {} generations ({:?}), {} candidates, {} rejected; seed {}",
         rep.generations, rep.termination, rep.evaluations, rep.rejected, rep.seed
     );
-    println!("λ = {:.4}, best fitness {:.3} %", rep.lambda, rep.best_fit);
+    println!(
+        "λ = {:.4}, penalty centre {}, best fitness {:.3} %",
+        rep.lambda,
+        centre_name(rep.centre),
+        rep.best_fit
+    );
     let tables = tables::Tables::from_ga(&rep, &trials).ok();
     if let Some(t) = &tables {
         println!("{}", t.to_markdown());
@@ -397,6 +431,7 @@ pub fn tune(args: &TuneArgs) -> Result<()> {
         "seed": rep.seed,
         "lambda": rep.lambda,
         "r": rep.r,
+        "centre": centre_name(rep.centre),
         "best_fit": rep.best_fit,
         "generations": rep.generations,
         "termination": rep.termination,

@@ -295,14 +295,14 @@ pub fn run(cfg: &DemoConfig, say: &mut dyn FnMut(&str)) -> Result<Outcome, DemoE
     let pem_cfg = PemConfig::default();
     let base = pem::identify(&ident[..1], None, &pem_cfg).map_err(step("identification"))?;
     let conv_rep = pem::identify(&ident, None, &pem_cfg).map_err(step("identification"))?;
-    // The penalty pulls each record's model towards the model of all simulation records
-    // together (a prior from the simulator), not towards zero.
+    // The penalty's centre is a gene: zero (the paper) or the model of all simulation records
+    // together (a prior from the simulator); the GA keeps whichever predicts the trials best.
     let mut ga_cfg = GaConfig {
         seed,
         progress: cfg.progress,
         ..cfg.ga.clone()
     };
-    ga_cfg.pem.nominal = Some(conv_rep.model.theta());
+    ga_cfg.centres = vec![None, Some(conv_rep.model.theta())];
     let (conventional, tuned, tuning_note) = match ga::tune(&ident, est, &base.model, &ga_cfg) {
         Ok(rep) => {
             let conv = match &rep.conventional {
@@ -320,7 +320,15 @@ pub fn run(cfg: &DemoConfig, say: &mut dyn FnMut(&str)) -> Result<Outcome, DemoE
                 fit: fits_of(&rep.best_model, val),
                 model: rep.best_model.clone(),
                 std_pct: rep.tuned.std_pct.clone(),
-                note: format!("regularised PEM, λ = {:.3e}, averaged", rep.lambda),
+                note: format!(
+                    "regularised PEM, λ = {:.3e}, penalty centre {}, averaged",
+                    rep.lambda,
+                    if rep.centre == 0 {
+                        "zero"
+                    } else {
+                        "the all-records model"
+                    }
+                ),
             };
             let note = format!(
                 "GA: {} generations ({}), {} candidates evaluated, {} rejected by the STD rule or stability; λ = {:.3e}, R = [{}]; fitness {:.2} % on the {} tuning trials",
@@ -601,7 +609,7 @@ mod tests {
     /// and the same seed gives the same model. (Its fit on these trials stays within a pp of
     /// the conventional model's; see the printed figures.)
     #[test]
-    fn ga_with_the_simulator_prior_meets_the_std_rule_and_is_reproducible() {
+    fn ga_beats_conventional_on_dead_time_trials_within_the_std_rule_reproducibly() {
         let ship = Ship::default_lng();
         let noise = NoiseSpec {
             gyro_std_degps: 0.03,
@@ -626,7 +634,7 @@ mod tests {
         let mut cfg = DemoConfig::default().ga;
         cfg.seed = 3;
         cfg.progress = false;
-        cfg.pem.nominal = Some(all.theta());
+        cfg.centres = vec![None, Some(all.theta())];
         let rep = ga::tune(&sim_recs, &trials, &base, &cfg).unwrap();
         let conv = rep.conventional.as_ref().unwrap();
         let f = |m: &Model, k: usize| {
@@ -651,7 +659,11 @@ mod tests {
         println!("conventional worst STD% {conv_worst:.1}");
         assert!(worst_std <= cfg.std_limit, "{:?}", rep.tuned.std_pct);
         assert!(conv_worst > worst_std);
-        assert!((t5 - c5).abs() < 1.0 && (t10 - c10).abs() < 1.5);
+        // the acceptance: the tuned model beats the conventional one at 5 and 10 steps
+        assert!(
+            t5 > c5 && t10 > c10,
+            "tuned {t5}/{t10} vs conventional {c5}/{c10}"
+        );
         let again = ga::tune(&sim_recs, &trials, &base, &cfg).unwrap();
         assert_eq!(again.best_model, rep.best_model);
     }
