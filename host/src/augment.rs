@@ -455,7 +455,7 @@ fn choose_actuator(
         }
     };
     let mut pick: Vec<usize> = Vec::new();
-    let mut add_best = |c: &[f64], pick: &mut Vec<usize>| {
+    let add_best = |c: &[f64], pick: &mut Vec<usize>| {
         let mut idx: Vec<usize> = (0..grid.len()).filter(|i| c[*i].is_finite()).collect();
         idx.sort_by(|a, b| c[*a].total_cmp(&c[*b]));
         for i in idx.into_iter().take(TOP_FROZEN) {
