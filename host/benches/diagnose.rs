@@ -1,5 +1,6 @@
 //! Criterion benchmarks of the simulator (one 1 800-sample record), `diagnose` on 3 + 3
-//! records of 1 800 samples (with and without the confirming refit) and `augment` with a
+//! records of 1 800 samples (with and without the confirming refit) and on 3 600 samples
+//! (one reference and one trial record, the CLI's smallest honest use), and `augment` with a
 //! dead time.
 
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -48,6 +49,10 @@ fn bench(c: &mut Criterion) {
     };
     g.bench_function("ref3_trials3_N1800_no_confirm", |b| {
         b.iter(|| diagnose::diagnose(&model, &reference, &est, &val, &quick).unwrap())
+    });
+    // 3 600 samples in all: one reference record, one trial record (its last 30 % held out)
+    g.bench_function("ref1_trial1_3600_samples", |b| {
+        b.iter(|| diagnose::diagnose(&model, &reference[..1], &est[..1], &[], &cfg).unwrap())
     });
     g.bench_function("augment_dead_time_trials3_N1800", |b| {
         b.iter(|| {
