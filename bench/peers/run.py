@@ -1168,15 +1168,18 @@ def run_case_yawcast(yc, case, mdir, rows, args, log_print):
     except Exception as e:  # noqa: BLE001
         row.update(error=str(e))
     rows.append(row)
-    # diagnose + augment start from a model of the raw record: the offsets are physics
-    # (bias, gyro bias, …) that diagnose is there to name
+    # the documented workflow: the model of the simulator's (reference) record, diagnosed on
+    # the trial against that reference, then augmented (re-identified with the effect) on the
+    # trial; plain PEM on the raw trial record when there is no verdict or augment declines
     raw = mdir / "yawcast-pem-raw.postcard"
+    refm = mdir / "yawcast-ref.postcard"
     try:
         yc.identify(case.est, raw, seed)
+        yc.identify(case.ref, refm, seed)
         pem_ok = True
     except Exception as e:  # noqa: BLE001
         pem_ok = False
-        log_print(f"  yawcast identify on the raw record of {case.name} failed: {e}")
+        log_print(f"  yawcast identify on the raw or reference record of {case.name} failed: {e}")
     # GA-tuned: the paper's recipe — PEM on the simulator's record, GA fitness on the trial record
     if not args.no_ga:
         ga = mdir / "yawcast-ga.postcard"
@@ -1192,12 +1195,13 @@ def run_case_yawcast(yc, case, mdir, rows, args, log_print):
         row = {"case": case.name, "effect": case.effect, "seed": case.seed, "tool": "yawcast-aug"}
         try:
             dj = mdir / "diagnose.json"
-            wall_d, ddoc = yc.diagnose(raw, case.est, case.ref, dj, seed)
+            wall_d, ddoc = yc.diagnose(refm, case.est, case.ref, dj, seed)
             verdict = _find(ddoc, "verdict", "effect", "best", "missing")
             if isinstance(verdict, str) and verdict in EFFECTS:
                 aug = mdir / "yawcast-aug.postcard"
-                wall_a, t_a, _ = yc.augment(raw, case.est, verdict, aug, seed)
-                row.update(model=str(yc.twin(aug)))
+                wall_a, t_a, adoc = yc.augment(refm, case.est, verdict, aug, seed)
+                kept = adoc.get("kept", True) if isinstance(adoc, dict) else True
+                row.update(model=str(yc.twin(aug if kept else raw)), kept=bool(kept))
             else:
                 wall_a, t_a = 0.0, None
                 row.update(model=str(yc.twin(raw)))
@@ -1607,8 +1611,9 @@ def notes(meta, args):
         "- yawcast: `identify` (plain PEM, λ = 0) on the same mean-removed estimation record the peers see "
         "(operating point added back when predicting, as for them); `tune` (GA over λ, R, the paper's recipe: PEM on the clean simulator's record, fitness = k-step fit on the estimation record as the trial); `diagnose` "
         "against the clean simulator's record, then `augment` with the diagnosed effect (a model with no verdict "
-        "stays plain); diagnose and augment start from plain PEM on the raw estimation record, since offsets are "
-        "physics (bias, gyro bias) they are there to name. Its models are read from the JSON twin (a, b, k and the effects) and scored by the same "
+        "stays plain) — the documented workflow: diagnose gets the model identified on the reference (simulator) "
+        "record, augment re-identifies it with the effect on the estimation record; with no verdict, or when "
+        "augment declines the effect, the row is plain PEM on the raw estimation record. Its models are read from the JSON twin (a, b, k and the effects) and scored by the same "
         "predictor, effects included (dead time → saturation → rate limit, bias, asymmetry, damping, heading "
         "terms, gyro bias), as `host/src/predict.rs` defines them.",
     ]
