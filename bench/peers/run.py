@@ -1052,10 +1052,11 @@ class Yawcast:
         t = _find(doc, *self.TIME_KEYS)
         return (float(t) if t is not None else None), doc
 
-    def identify(self, data, out, seed):
+    def identify(self, data, out, seed, focus=None):
         j = Path(out).with_suffix(".run.json")
         # `identify` is deterministic (no --seed)
-        wall = self._run("identify", "--data", data, "--order", ORDER, "--out", out, "--json", j)
+        extra = ["--focus", focus] if focus else []
+        wall = self._run("identify", "--data", data, "--order", ORDER, "--out", out, "--json", j, *extra)
         t, doc = self._time(j)
         return wall, t, doc
 
@@ -1106,9 +1107,10 @@ def yawcast_binary(arg, allow_debug=False):
 # --------------------------------------------------------------------------------------
 # the benchmark
 
-YAWCAST_TOOLS = ["yawcast-pem", "yawcast-ga", "yawcast-aug"]
+YAWCAST_TOOLS = ["yawcast-pem", "yawcast-focus", "yawcast-ga", "yawcast-aug"]
 YAWCAST_LABEL = {
     "yawcast-pem": "yawcast plain PEM",
+    "yawcast-focus": "yawcast PEM, 10-step focus",
     "yawcast-ga": "yawcast GA-tuned (λ, R)",
     "yawcast-aug": "yawcast diagnosed + augmented",
 }
@@ -1168,6 +1170,16 @@ def run_case_yawcast(yc, case, mdir, rows, args, log_print):
     except Exception as e:  # noqa: BLE001
         row.update(error=str(e))
     rows.append(row)
+    # PEM refined on 10-step errors (`identify --focus 10`), same record and operating point
+    if "error" not in row:
+        foc = mdir / "yawcast-focus.postcard"
+        frow = {"case": case.name, "effect": case.effect, "seed": case.seed, "tool": "yawcast-focus"}
+        try:
+            wall, t_in, _ = yc.identify(centered, foc, seed, focus=10)
+            frow.update(wall_s=wall, inproc_s=t_in, model=str(yc.twin(foc)), u0=u0, y0=y0)
+        except Exception as e:  # noqa: BLE001
+            frow.update(error=str(e))
+        rows.append(frow)
     # the documented workflow: the model of the simulator's (reference) record, diagnosed on
     # the trial against that reference, then augmented (re-identified with the effect) on the
     # trial; plain PEM on the raw trial record when there is no verdict or augment declines

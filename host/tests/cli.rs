@@ -1039,3 +1039,53 @@ fn tune_beats_conventional_on_dead_time_trials_and_pins_its_json() {
         serde_json::from_slice(&std::fs::read(d.join("zero.json")).unwrap()).unwrap();
     assert_eq!(z["centre"], "zero");
 }
+
+#[test]
+fn identify_focus_refines_on_k_step_errors_and_pins_its_json() {
+    use yawcast::sim::SimEffect;
+    use yawcast_shared::model::EffectKind;
+    let d = scratch("focus");
+    let recs = sim_csvs(
+        &d,
+        "trial",
+        Some(SimEffect::hidden(EffectKind::DeadTime, 1.0)),
+        &[601, 602],
+    );
+    let fit10 = |json: &Path| {
+        let v: serde_json::Value = serde_json::from_slice(&std::fs::read(json).unwrap()).unwrap();
+        (v["fit"]["10"].as_f64().unwrap(), v["focus"].clone())
+    };
+    let ident = |extra: &[&str], json: &Path| {
+        let o = bin()
+            .arg("identify")
+            .arg("--data")
+            .arg(&recs[0])
+            .arg("--validate")
+            .arg(&recs[1])
+            .args(extra)
+            .arg("--json")
+            .arg(json)
+            .output()
+            .unwrap();
+        assert_eq!(code(&o), 0, "{}", stderr(&o));
+        stdout(&o)
+    };
+    ident(&[], &d.join("plain.json"));
+    let out = ident(&["--focus", "10"], &d.join("focus.json"));
+    assert!(out.contains("focus on 10-step errors"), "{out}");
+    let (plain, none) = fit10(&d.join("plain.json"));
+    let (focused, ten) = fit10(&d.join("focus.json"));
+    assert_eq!(none, serde_json::Value::Null);
+    assert_eq!(ten, 10);
+    // a 2 s dead time the 4th-order one-step optimum cannot hold over 10 steps
+    assert!(focused > plain + 1.0, "10-step fit {plain} → {focused}");
+    let o = run(&[
+        "identify",
+        "--data",
+        recs[0].to_str().unwrap(),
+        "--focus",
+        "0",
+    ]);
+    assert_eq!(code(&o), 2);
+    assert!(stderr(&o).contains("--focus"), "{}", stderr(&o));
+}

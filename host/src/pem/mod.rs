@@ -16,6 +16,7 @@
 //! `σ̂² = Σε²/(N − p)`. The paper's reliability rule is reported: any STD% above 10 makes the
 //! model unreliable, above 50 unusable.
 
+pub mod focus;
 mod init;
 pub(crate) mod poly;
 pub(crate) mod sens;
@@ -320,6 +321,9 @@ pub enum IdentError {
     /// The optimum is not stable.
     #[error("the identified model is unstable")]
     Unstable,
+    /// Predictions are not finite, or nothing is measured (see [`focus::refine`]).
+    #[error("cannot refine: {0}")]
+    Refine(String),
 }
 
 /// Samples needed for `unknowns` estimated numbers.
