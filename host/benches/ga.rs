@@ -105,30 +105,30 @@ fn full_run_centres(
 fn bench_ga(c: &mut Criterion) {
     let threads = rayon::current_num_threads();
     if std::env::var("YAWCAST_BENCH_FULL").is_ok_and(|v| v == "1") {
+        let summary = |rep: &ga::GaReport| {
+            let conv = rep.conventional.as_ref().unwrap();
+            format!(
+                "{} evaluations in the winning run, centre {}, {} rejected; 5/10-step fit tuned \
+                 {:.2}/{:.2} % vs conventional {:.2}/{:.2} %",
+                rep.evaluations,
+                rep.centre,
+                rep.rejected,
+                rep.tuned.fits["5"],
+                rep.tuned.fits["10"],
+                conv.fits["5"],
+                conv.fits["10"]
+            )
+        };
         let (s, rep) = full_run(15, 15, 1800, 50);
-        let conv = rep.conventional.as_ref().unwrap();
         eprintln!(
-            "GA 15+15×1800, 50 generations, {threads} threads: {s:.2} s ({} evaluations, {} rejected); \
-             5/10-step fit tuned {:.2}/{:.2} % vs conventional {:.2}/{:.2} %",
-            rep.evaluations,
-            rep.rejected,
-            rep.tuned.fits["5"],
-            rep.tuned.fits["10"],
-            conv.fits["5"],
-            conv.fits["10"]
+            "GA 15+15×1800, 50 generations, {threads} threads: {s:.2} s ({})",
+            summary(&rep)
         );
         let (s, rep) = full_run_centres(15, 15, 1800, 50, true);
-        let conv = rep.conventional.as_ref().unwrap();
         eprintln!(
-            "GA 15+15×1800, 50 generations per centre, two centres (tune's default), {threads} threads: \
-             {s:.2} s ({} evaluations in the winning run, centre {}); 5/10-step fit tuned {:.2}/{:.2} % \
-             vs conventional {:.2}/{:.2} %",
-            rep.evaluations,
-            rep.centre,
-            rep.tuned.fits["5"],
-            rep.tuned.fits["10"],
-            conv.fits["5"],
-            conv.fits["10"]
+            "GA 15+15×1800, 50 generations per centre, two centres (tune's default), {threads} \
+             threads: {s:.2} s ({})",
+            summary(&rep)
         );
         for trials in [5usize, 15, 30] {
             let (s, rep) = full_run(15, trials, 1800, 10);

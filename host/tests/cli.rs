@@ -975,16 +975,20 @@ fn tune_beats_conventional_on_dead_time_trials_and_pins_its_json() {
         Some(SimEffect::hidden(EffectKind::DeadTime, 1.0)),
         &[501, 502, 503],
     );
+    // `yawcast tune --data <sims> --validate <trials>`
+    let tune = |trials: &[PathBuf]| {
+        let mut c = bin();
+        c.arg("tune");
+        for p in &sims {
+            c.arg("--data").arg(p);
+        }
+        for p in trials {
+            c.arg("--validate").arg(p);
+        }
+        c
+    };
     let json = d.join("tune.json");
-    let mut cmd = bin();
-    cmd.arg("tune");
-    for p in &sims {
-        cmd.arg("--data").arg(p);
-    }
-    for p in &trials {
-        cmd.arg("--validate").arg(p);
-    }
-    let o = cmd
+    let o = tune(&trials)
         .args(["--generations", "15", "--seed", "7", "--json"])
         .arg(&json)
         .output()
@@ -1013,27 +1017,19 @@ fn tune_beats_conventional_on_dead_time_trials_and_pins_its_json() {
         .fold(0.0, f64::max);
     assert!(worst <= 10.0, "tuned STD% {worst}");
     // the paper's centre alone is still there
-    let o = {
-        let mut c = bin();
-        c.arg("tune");
-        for p in &sims {
-            c.arg("--data").arg(p);
-        }
-        c.arg("--validate")
-            .arg(&trials[0])
-            .args([
-                "--generations",
-                "3",
-                "--centre",
-                "zero",
-                "--seed",
-                "7",
-                "--json",
-            ])
-            .arg(d.join("zero.json"))
-            .output()
-            .unwrap()
-    };
+    let o = tune(&trials[..1])
+        .args([
+            "--generations",
+            "3",
+            "--centre",
+            "zero",
+            "--seed",
+            "7",
+            "--json",
+        ])
+        .arg(d.join("zero.json"))
+        .output()
+        .unwrap();
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let z: serde_json::Value =
         serde_json::from_slice(&std::fs::read(d.join("zero.json")).unwrap()).unwrap();
