@@ -587,7 +587,7 @@ pub fn tune_with(
     cfg: &GaConfig,
     on_generation: &mut dyn FnMut(&GenStats),
 ) -> Result<GaReport, GaError> {
-    let p = 3 * base.n + base.effect_gains().len();
+    let p = pem::params_of(base).len();
     for (i, c) in cfg.centres.iter().enumerate() {
         if let Some(v) = c {
             if v.len() != p || v.iter().any(|x| !x.is_finite()) {

@@ -317,7 +317,7 @@ pub enum Centre {
     Zero,
     /// θ₀ = the model identified on all `--data` records together (the simulator's prior).
     Simulation,
-    /// Both: an extra gene lets the GA choose the one that predicts the trials best.
+    /// Both: one GA run around each, and the run that predicts the trials best wins.
     Both,
 }
 
@@ -380,7 +380,7 @@ pub fn tune(args: &TuneArgs) -> Result<()> {
         })
         .collect::<Result<_>>()?;
     let seed = args.seed.resolve();
-    let cfg = ga::GaConfig {
+    let mut cfg = ga::GaConfig {
         seed,
         max_generations: args.generations,
         horizons,
@@ -405,7 +405,6 @@ pub fn tune(args: &TuneArgs) -> Result<()> {
         .map_err(input_ident)
         .context("the starting model")?
         .model;
-    let mut cfg = cfg;
     if args.centre != Centre::Zero {
         let all = pem::identify(&sim, None, &base_cfg)
             .map_err(input_ident)

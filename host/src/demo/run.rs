@@ -295,8 +295,8 @@ pub fn run(cfg: &DemoConfig, say: &mut dyn FnMut(&str)) -> Result<Outcome, DemoE
     let pem_cfg = PemConfig::default();
     let base = pem::identify(&ident[..1], None, &pem_cfg).map_err(step("identification"))?;
     let conv_rep = pem::identify(&ident, None, &pem_cfg).map_err(step("identification"))?;
-    // The penalty's centre is a gene: zero (the paper) or the model of all simulation records
-    // together (a prior from the simulator); the GA keeps whichever predicts the trials best.
+    // Two penalty centres, one GA run each: zero (the paper) and the model of all simulation
+    // records together (a prior from the simulator); the run that predicts the trials best wins.
     let mut ga_cfg = GaConfig {
         seed,
         progress: cfg.progress,
