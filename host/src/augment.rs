@@ -8,8 +8,8 @@
 //!    both have seen the same data.
 //! 2. **Candidate.** The effect is appended (stacked on the model's effects).
 //!    - *Linear-gain effects* (bias, gyro bias, asymmetry, nonlinear damping, wind, current):
-//!      PEM ([`pem::identify`]) from the ARX and ARMAX starts and from the input model with
-//!      the new gain at zero; the lowest estimation cost wins.
+//!      PEM ([`pem::identify`]) from the ARX, ARMAX and subspace starts and from the input
+//!      model with the new gain at zero; the lowest estimation cost wins.
 //!    - *Actuator effects* (dead time d, slew limit ρ, angle limit δ_max): a grid of the
 //!      structural parameter (d = 1..=[`MAX_DEAD_TIME`] samples; ρ on a log grid over
 //!      0.5–20 °/s, which covers real steering gears' 2.3–9 °/s; δ_max over the quantiles
@@ -29,11 +29,18 @@
 //!    actuator parameter counts as one parameter), its paired held-out fit gain over the
 //!    baseline at 10 steps or in simulation is significant against the spread of the gain
 //!    over records (one-sided Student t at 95 %; records are cut into blocks so that at
-//!    least twelve units carry the spread), neither horizon is significantly worse, and it does not validate
+//!    least twelve units carry the spread) — or, when ΔBIC ≤ −10 (decisive evidence on the
+//!    estimation records), the gain is merely not negative: a re-identified 4th-order model
+//!    can absorb a short delay into its poles and predict as well, and the physical model is
+//!    then preferred — neither horizon is significantly worse, and it does not validate
 //!    worse than the input model at 10 steps or in simulation. Otherwise the input model is
 //!    returned unchanged, with the reason.
 
 use std::collections::BTreeMap;
+
+/// ΔBIC at or below which the estimation evidence for an effect counts as decisive ("very
+/// strong", Kass and Raftery 1995): the effect is then kept when it predicts no worse.
+const DECISIVE_BIC: f64 = -10.0;
 
 use rayon::prelude::*;
 use serde::{Serialize, Serializer};
@@ -328,7 +335,7 @@ fn n_params(m: &Model) -> usize {
     3 * m.n + m.effect_gains().len()
 }
 
-/// Identifies `template`'s structure on `est`: ARX, ARMAX and the template itself as
+/// Identifies `template`'s structure on `est`: ARX, ARMAX, subspace and the template itself as
 /// starts (the template only when it is stable), lowest cost wins.
 fn reidentify(
     est: &[Record],
@@ -780,7 +787,12 @@ pub fn augment(
         ));
     }
     let sig = t10 > tc || tsim > tc;
-    if !sig {
+    // decisive estimation evidence (ΔBIC ≤ −10, "very strong" on Kass and Raftery's scale)
+    // with held-out prediction no worse: the effect explains with physics what the
+    // re-identified structure otherwise absorbs into θ (a delay into extra poles), so the
+    // physical model is kept — it predicts as well and can go into the simulator
+    let decisive = delta_bic <= DECISIVE_BIC && t10 >= -tc && tsim >= -tc;
+    if !sig && !decisive {
         reasons.push(format!(
             "the held-out gain over the re-identified model ({g10:+.2} ± {se10:.2} pp at 10 steps, \
              {gsim:+.2} ± {sesim:.2} pp in simulation) is within the record-to-record spread"
@@ -838,10 +850,18 @@ pub fn augment(
     if !search_note.is_empty() {
         text.push_str(&format!(" ({search_note})"));
     }
-    if kept {
+    if kept && sig {
         text.push_str(&format!(
             ". Kept: the gain of {g10:+.2} pp at 10 steps and {gsim:+.2} pp in simulation is \
              significant against its spread over held-out records"
+        ));
+    } else if kept {
+        text.push_str(&format!(
+            ". Kept: the estimation records support it decisively (ΔBIC {delta_bic:+.1} ≤ \
+             {DECISIVE_BIC}) and it predicts the held-out records as well as the model \
+             re-identified without it ({g10:+.2} ± {se10:.2} pp at 10 steps, {gsim:+.2} ± \
+             {sesim:.2} pp in simulation), which absorbs the effect into its poles; the \
+             physical model is preferred"
         ));
     } else {
         text.push_str(&format!(". Not kept: {}", reasons.join("; ")));

@@ -310,6 +310,48 @@ pub fn k_step(model: &Model, rec: &Record, x0: &[f64], k: usize) -> Vec<f64> {
     out
 }
 
+/// Predictions at several horizons in one pass: `out[i][t] = ŷ(t|t−horizons[i])`, the same
+/// numbers [`k_step`] gives for each horizon (horizons 0 count as 1). Costs one pass of
+/// `max(horizons)` open-loop steps per sample instead of one per horizon.
+///
+/// ```
+/// use yawcast::{data::Record, model::Model, predict};
+/// let m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.3, 0.1]).unwrap();
+/// let r = Record::from_uy("r", 1.0, vec![1.0, -1.0, 1.0, 1.0, -1.0], vec![0.0, 0.1, 0.0, 0.2, 0.1]);
+/// let all = predict::k_steps(&m, &r, &[0.0, 0.0], &[1, 3]);
+/// assert_eq!(all[1], predict::k_step(&m, &r, &[0.0, 0.0], 3));
+/// assert_eq!(all[0], predict::k_step(&m, &r, &[0.0, 0.0], 1));
+/// ```
+pub fn k_steps(model: &Model, rec: &Record, x0: &[f64], horizons: &[usize]) -> Vec<Vec<f64>> {
+    let hs: Vec<usize> = horizons.iter().map(|h| (*h).max(1)).collect();
+    let kmax = hs.iter().copied().max().unwrap_or(1);
+    let s = Stepper::new(model);
+    let n = rec.len();
+    let mut states = Vec::with_capacity(n);
+    let mut st = s.initial(x0, psi0(rec));
+    for t in 0..n {
+        states.push(st.clone());
+        s.step(&mut st, rec.u[t], rec.y[t], psi_at(rec, t));
+    }
+    let mut out = vec![vec![0.0; n]; hs.len()];
+    for start in 0..n {
+        // sample t = start + j is predicted j + 1 steps ahead; k_step uses this pass for
+        // horizon h at t = start + h − 1, and the pass from 0 for every t < h − 1
+        let mut w = states[start].clone();
+        for j in 0..kmax.min(n - start) {
+            let t = start + j;
+            let yh = s.output(&w);
+            for (o, &h) in out.iter_mut().zip(&hs) {
+                if j + 1 == h || (start == 0 && j + 1 < h) {
+                    o[t] = yh;
+                }
+            }
+            s.step(&mut w, rec.u[t], f64::NAN, None);
+        }
+    }
+    out
+}
+
 /// Pure simulation from x̂(0) = `x0` (no measurement used; heading integrated from the
 /// simulated rate, starting at the measured ψ(0) when logged).
 pub fn simulate(model: &Model, rec: &Record, x0: &[f64]) -> Vec<f64> {
@@ -455,6 +497,34 @@ mod tests {
             s.step(&mut st, r.u[j], f64::NAN, None);
         }
         assert_eq!(pred[t], s.output(&st));
+    }
+
+    /// The one-pass multi-horizon predictions equal `k_step`'s bit for bit over the whole
+    /// record, with actuator, damping and heading effects and missing samples.
+    #[test]
+    fn k_steps_equal_k_step_bit_for_bit() {
+        let m = m4()
+            .with_effect(Effect::DeadTime { samples: 2 })
+            .with_effect(Effect::RateLimit { rate: 3.0 })
+            .with_effect(Effect::NonlinearDamping {
+                beta: -0.01,
+                cubic: true,
+            })
+            .with_effect(Effect::Current {
+                beta_s: 0.2,
+                beta_c: -0.1,
+            });
+        let mut r = rec(150);
+        r.psi = Some((0..150).map(|i| i as f64 * 1.7).collect());
+        r.y[40] = f64::NAN;
+        let x0 = [0.1, -0.2, 0.0, 0.3];
+        let hs = [1, 3, 7, 20, 200];
+        let all = k_steps(&m, &r, &x0, &hs);
+        for (h, got) in hs.iter().zip(&all) {
+            let want = k_step(&m, &r, &x0, *h);
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(got), bits(&want), "horizon {h}");
+        }
     }
 
     #[test]

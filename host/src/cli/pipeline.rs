@@ -109,10 +109,11 @@ pub struct IdentifyArgs {
     #[arg(long, default_value_t = 0.0, value_name = "LAMBDA")]
     pub lambda: f64,
     /// Refine the PEM optimum to minimise K-step prediction errors (MATLAB's Focus) — for a
-    /// predictor used K steps ahead when the model structure is not exact. STD%, AIC and BIC
-    /// stay those of the one-step optimum it starts from.
-    #[arg(long, value_name = "K")]
-    pub focus: Option<usize>,
+    /// predictor used K steps ahead when the model structure is not exact. A list
+    /// (`1,2,5,10,20`) minimises the mean over the horizons of each one's error relative to
+    /// the start's. STD%, AIC and BIC stay those of the one-step optimum it starts from.
+    #[arg(long, value_name = "K[,K…]", value_delimiter = ',')]
+    pub focus: Vec<usize>,
     /// Where the model goes: `<PATH>.postcard` and its `<PATH>.json` twin.
     #[arg(long, value_name = "PATH")]
     pub out: Option<PathBuf>,
@@ -153,8 +154,10 @@ pub struct IdentifySummary {
     pub model: Option<String>,
     /// Wall-clock seconds of the identification itself (reading and writing excluded).
     pub identify_s: f64,
-    /// The horizon of `--focus` (null: plain one-step PEM).
+    /// The longest horizon of `--focus` (null: plain one-step PEM).
     pub focus: Option<usize>,
+    /// Every horizon of `--focus`, ascending (empty: plain one-step PEM).
+    pub focus_horizons: Vec<usize>,
 }
 
 /// Runs `identify`.
@@ -167,11 +170,14 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
         lambda: args.lambda,
         ..pem::PemConfig::default()
     };
-    if args.focus == Some(0) {
-        return Err(bad("--focus: the horizon must be a whole number ≥ 1"));
+    if args.focus.contains(&0) {
+        return Err(bad("--focus: every horizon must be a whole number ≥ 1"));
     }
+    let mut horizons = args.focus.clone();
+    horizons.sort_unstable();
+    horizons.dedup();
     if let Some(o) = &args.orders {
-        if args.focus.is_some() {
+        if !horizons.is_empty() {
             return Err(bad(
                 "--focus refines one model; it does not go with --orders",
             ));
@@ -222,16 +228,28 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
     }
     let started = std::time::Instant::now();
     let rep = pem::identify(&recs, None, &cfg).map_err(input_ident)?;
-    let model = match args.focus {
-        Some(k) if k > 1 => {
-            let f = pem::focus::refine(&recs, &rep.model, k, 50, 1e-7).map_err(input_ident)?;
-            println!(
-                "focus on {k}-step errors: mean square {:.4e} → {:.4e} after {} steps",
-                f.cost_before, f.cost, f.iterations
-            );
-            f.model
-        }
-        _ => rep.model.clone(),
+    let model = if horizons.iter().any(|k| *k > 1) {
+        let fc = pem::focus::FocusConfig {
+            horizons: horizons.clone(),
+            ..Default::default()
+        };
+        let f = pem::focus::refine(&recs, &rep.model, &fc).map_err(input_ident)?;
+        let per: Vec<String> = f
+            .horizons
+            .iter()
+            .zip(f.mse_before.iter().zip(&f.mse))
+            .map(|(k, (a, b))| format!("{k}: {a:.4e} → {b:.4e}"))
+            .collect();
+        let ks: Vec<String> = f.horizons.iter().map(usize::to_string).collect();
+        println!(
+            "focus on {}-step errors: mean square {} after {} steps",
+            ks.join(","),
+            per.join(", "),
+            f.iterations
+        );
+        f.model
+    } else {
+        rep.model.clone()
     };
     let identify_s = started.elapsed().as_secs_f64();
     println!(
@@ -286,7 +304,8 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
         fit,
         model: written,
         identify_s,
-        focus: args.focus,
+        focus: horizons.last().copied(),
+        focus_horizons: horizons,
     })
 }
 

@@ -1,13 +1,16 @@
-//! Multi-step focus: a model refined to minimise its k-step prediction errors instead of the
-//! one-step errors of plain PEM (MATLAB's `Focus`), for predictors used k steps ahead.
+//! Multi-step focus: a model refined to minimise its k-step prediction errors over a set of
+//! horizons instead of the one-step errors alone (MATLAB's `Focus`, multi-step prediction-error
+//! identification), for predictors used k steps ahead.
 //!
 //! One-step PEM is the maximum-likelihood answer when the model structure is right. When it is
 //! not (an actuator delay longer than the order can hold, a nonlinearity), the one-step
 //! optimum weights high frequencies and its 10- or 20-step predictions suffer. The refinement
-//! starts from the one-step optimum and minimises `V_k(θ) = (1/M) Σ (y(t) − ŷ(t|t−k))²` over
-//! the same parameters by Levenberg–Marquardt with a forward-difference Jacobian (θ has 3n
-//! entries, one k-step pass each), x̂(0) re-estimated for every evaluation as the predictor
-//! does, every step kept inside the stability region of A and A − KC (rounded to f32 too).
+//! starts from the one-step optimum and minimises the mean over the horizons h of
+//! `V_h(θ) / V_h(θ₀)`, `V_h = (1/M) Σ (y(t) − ŷ(t|t−h))²` (each horizon counts by its relative
+//! improvement), over the same parameters by Levenberg–Marquardt with a forward-difference
+//! Jacobian (θ has 3n entries, one pass over every horizon each), x̂(0) re-estimated for every
+//! evaluation as the predictor does, every step kept inside the stability region of A and
+//! A − KC (rounded to f32 too).
 
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
@@ -18,39 +21,75 @@ use crate::data::Record;
 use crate::model::Model;
 use crate::predict;
 
+/// Settings of [`refine`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct FocusConfig {
+    /// Horizons whose k-step errors are minimised (each ≥ 1; 1 alone leaves a PEM optimum).
+    pub horizons: Vec<usize>,
+    /// Levenberg–Marquardt iteration cap.
+    pub max_iter: usize,
+    /// Stop when an accepted step lowers the cost by less than this (relative).
+    pub tol: f64,
+}
+
+impl Default for FocusConfig {
+    /// Horizons 1, 5, 10 and 20, at most 50 iterations, relative tolerance 1e-7.
+    fn default() -> Self {
+        FocusConfig {
+            horizons: vec![1, 5, 10, 20],
+            max_iter: 50,
+            tol: 1e-7,
+        }
+    }
+}
+
 /// What [`refine`] did.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FocusReport {
     /// The refined model (structure and effects of the start).
     pub model: Model,
-    /// The horizon k whose errors were minimised.
-    pub horizon: usize,
-    /// Mean squared k-step error of the start.
-    pub cost_before: f64,
-    /// Mean squared k-step error of the refined model.
+    /// The horizons whose errors were minimised.
+    pub horizons: Vec<usize>,
+    /// Mean squared k-step error of the start, per horizon.
+    pub mse_before: Vec<f64>,
+    /// Mean squared k-step error of the refined model, per horizon.
+    pub mse: Vec<f64>,
+    /// The minimised cost, mean over the horizons of mse / mse_before (1 at the start).
     pub cost: f64,
     /// Accepted Levenberg–Marquardt steps.
     pub iterations: usize,
 }
 
-/// k-step errors over every record (0 where y is not measured); `None` when a prediction is
-/// not finite.
-fn residuals(model: &Model, recs: &[Record], k: usize) -> Option<Vec<f64>> {
-    let mut out = Vec::with_capacity(recs.iter().map(Record::len).sum());
+/// k-step errors over every record for each horizon, horizon-major (0 where y is not
+/// measured); `None` when a prediction is not finite.
+fn residuals(model: &Model, recs: &[Record], hs: &[usize]) -> Option<Vec<f64>> {
+    let len: usize = recs.iter().map(Record::len).sum();
+    let mut out = vec![0.0; len * hs.len()];
+    let mut off = 0;
     for r in recs {
         let x0 = predict::estimate_x0(model, r);
-        let yh = predict::k_step(model, r, &x0, k);
-        for (y, h) in r.y.iter().zip(&yh) {
-            if !y.is_finite() {
-                out.push(0.0);
-            } else if h.is_finite() {
-                out.push(y - h);
-            } else {
-                return None;
+        for (i, yh) in predict::k_steps(model, r, &x0, hs).iter().enumerate() {
+            let o = &mut out[i * len + off..i * len + off + r.len()];
+            for ((slot, y), h) in o.iter_mut().zip(&r.y).zip(yh) {
+                if y.is_finite() {
+                    if !h.is_finite() {
+                        return None;
+                    }
+                    *slot = y - h;
+                }
             }
         }
+        off += r.len();
     }
     Some(out)
+}
+
+/// Mean square per horizon of horizon-major residuals.
+fn mse_per(e: &[f64], hs: usize, m: usize) -> Vec<f64> {
+    let len = e.len() / hs.max(1);
+    (0..hs)
+        .map(|i| mean_sq(&e[i * len..(i + 1) * len], m))
+        .collect()
 }
 
 fn mean_sq(e: &[f64], m: usize) -> f64 {
@@ -63,36 +102,41 @@ fn stable(model: &Model, params: &[f64]) -> bool {
         && poly::canonical_stable(&params[..n], &params[2 * n..3 * n])
 }
 
-/// Refines `start` so that its `horizon`-step predictions on `recs` fit best.
+/// Refines `start` so that its k-step predictions on `recs` fit best over `cfg.horizons`.
 ///
-/// `horizon = 1` returns the start (its one-step cost is already minimal when it is a PEM
-/// optimum). At most `max_iter` Levenberg–Marquardt iterations; stops when an accepted step
-/// lowers the cost by less than `tol` (relative) or no step lowers it.
+/// Horizons `[1]` return the start (its one-step cost is already minimal when it is a PEM
+/// optimum). At most `cfg.max_iter` Levenberg–Marquardt iterations; stops when an accepted
+/// step lowers the cost by less than `cfg.tol` (relative) or no step lowers it.
 ///
 /// # Errors
-/// [`IdentError::StartUnstable`] when `start` is unstable; [`IdentError::Refine`] when its
-/// predictions on `recs` are not finite or `recs` holds no measured sample.
+/// [`IdentError::StartUnstable`] when `start` is unstable; [`IdentError::Refine`] when no
+/// horizon is given, the start's predictions on `recs` are not finite or `recs` holds no
+/// measured sample.
 ///
 /// ```
 /// use yawcast::data::Record;
 /// use yawcast::model::Model;
-/// use yawcast::pem::focus;
+/// use yawcast::pem::focus::{refine, FocusConfig};
 /// let m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.3, 0.1]).unwrap();
 /// let u: Vec<f64> = (0..300).map(|t| if (t / 9) % 2 == 0 { 1.0 } else { -1.0 }).collect();
 /// let y = yawcast::predict::simulate(&m, &Record::from_uy("r", 1.0, u.clone(), vec![0.0; 300]), &[0.0, 0.0]);
 /// let rec = Record::from_uy("r", 1.0, u, y);
-/// let r = focus::refine(&[rec], &m, 5, 20, 1e-9).unwrap();
-/// assert!(r.cost <= r.cost_before);
-/// assert_eq!(r.horizon, 5);
+/// let cfg = FocusConfig { horizons: vec![1, 5], max_iter: 20, ..Default::default() };
+/// let r = refine(&[rec], &m, &cfg).unwrap();
+/// assert!(r.cost <= 1.0);
+/// assert_eq!(r.horizons, vec![1, 5]);
 /// ```
 pub fn refine(
     recs: &[Record],
     start: &Model,
-    horizon: usize,
-    max_iter: usize,
-    tol: f64,
+    cfg: &FocusConfig,
 ) -> Result<FocusReport, IdentError> {
-    let k = horizon.max(1);
+    let mut hs: Vec<usize> = cfg.horizons.iter().map(|h| (*h).max(1)).collect();
+    hs.sort_unstable();
+    hs.dedup();
+    if hs.is_empty() {
+        return Err(IdentError::Refine("no horizon to refine on".into()));
+    }
     let mut params = params_of(start);
     if !stable(start, &params) {
         return Err(IdentError::StartUnstable);
@@ -107,19 +151,34 @@ pub fn refine(
             "no measured samples to refine on".into(),
         ));
     }
-    let eval = |p: &[f64]| -> Option<Vec<f64>> { residuals(&with_params(start, p), recs, k) };
-    let Some(mut e) = eval(&params) else {
+    let Some(e0) = residuals(start, recs, &hs) else {
         return Err(IdentError::Refine(
             "the start's k-step predictions are not finite".into(),
         ));
     };
-    let cost_before = mean_sq(&e, m);
-    let mut cost = cost_before;
+    let mse_before = mse_per(&e0, hs.len(), m);
+    // residual weights: cost = Σ_h V_h / (H·V_h(start)) = mean square of the weighted residuals
+    let len = e0.len() / hs.len();
+    let w: Vec<f64> = mse_before
+        .iter()
+        .map(|v| 1.0 / (v * hs.len() as f64).sqrt().max(1e-300))
+        .collect();
+    let weigh = |mut e: Vec<f64>| -> Vec<f64> {
+        for (i, wi) in w.iter().enumerate() {
+            e[i * len..(i + 1) * len].iter_mut().for_each(|v| *v *= wi);
+        }
+        e
+    };
+    let eval = |p: &[f64]| -> Option<Vec<f64>> {
+        residuals(&with_params(start, p), recs, &hs).map(&weigh)
+    };
+    let mut e = weigh(e0);
+    let mut cost = mean_sq(&e, m);
     let mut iterations = 0;
-    if k > 1 {
+    if hs != [1] {
         let np = params.len();
         let mut mu = 1e-3;
-        for _ in 0..max_iter {
+        for _ in 0..cfg.max_iter {
             // forward-difference Jacobian of the residuals, one column per parameter
             let cols: Vec<Option<Vec<f64>>> = (0..np)
                 .into_par_iter()
@@ -159,7 +218,7 @@ pub fn refine(
                             mu = (mu / 3.0).max(1e-12);
                             iterations += 1;
                             accepted = true;
-                            if rel < tol {
+                            if rel < cfg.tol {
                                 mu = f64::INFINITY; // converged: leave the outer loop too
                             }
                             break;
@@ -173,10 +232,17 @@ pub fn refine(
             }
         }
     }
+    let model = with_params(start, &params);
+    let mse = mse_per(
+        &residuals(&model, recs, &hs).unwrap_or_default(),
+        hs.len(),
+        m,
+    );
     Ok(FocusReport {
-        model: with_params(start, &params),
-        horizon: k,
-        cost_before,
+        model,
+        horizons: hs,
+        mse_before,
+        mse,
         cost,
         iterations,
     })
@@ -203,8 +269,13 @@ mod tests {
         let est = vec![rec(1)];
         let val = [rec(2)];
         let one = identify(&est, None, &PemConfig::default()).unwrap().model;
-        let r = refine(&est, &one, 10, 30, 1e-9).unwrap();
-        assert!(r.cost < r.cost_before, "{} vs {}", r.cost, r.cost_before);
+        let cfg = FocusConfig {
+            horizons: vec![10],
+            max_iter: 30,
+            tol: 1e-9,
+        };
+        let r = refine(&est, &one, &cfg).unwrap();
+        assert!(r.cost < 1.0 && r.mse[0] < r.mse_before[0], "{r:?}");
         let f = |m: &Model, k: usize| fit_at(m, &val[0], Horizon::Steps(k));
         let (before, after) = (f(&one, 10), f(&r.model, 10));
         println!(
@@ -214,7 +285,47 @@ mod tests {
         assert!(after > before, "{before} → {after}");
         assert!(r.model.is_stable());
         // horizon 1 leaves a PEM optimum as it is
-        let same = refine(&est, &one, 1, 30, 1e-9).unwrap();
+        let one_step = FocusConfig {
+            horizons: vec![1],
+            ..cfg
+        };
+        let same = refine(&est, &one, &one_step).unwrap();
         assert_eq!(same.model, one);
+    }
+
+    #[test]
+    fn several_horizons_each_count_and_an_empty_list_is_an_error() {
+        let m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.3, 0.1]).unwrap();
+        let u: Vec<f64> = (0..400)
+            .map(|t| if (t / 7) % 3 == 0 { 1.0 } else { -1.0 })
+            .collect();
+        let truth = Model::new(1.0, vec![-0.1, 0.6], vec![0.12, 0.25], vec![0.2, 0.1]).unwrap();
+        let y = predict::simulate(
+            &truth,
+            &Record::from_uy("r", 1.0, u.clone(), vec![0.0; 400]),
+            &[0.0, 0.0],
+        );
+        let rec = Record::from_uy("r", 1.0, u, y);
+        let cfg = FocusConfig {
+            horizons: vec![5, 1, 5, 3],
+            max_iter: 30,
+            tol: 1e-10,
+        };
+        let r = refine(std::slice::from_ref(&rec), &m, &cfg).unwrap();
+        assert_eq!(r.horizons, vec![1, 3, 5]);
+        assert_eq!(r.mse.len(), 3);
+        // noise-free data of a model of the same structure: every horizon's error falls
+        for (a, b) in r.mse.iter().zip(&r.mse_before) {
+            assert!(*a < 0.01 * b, "{:?} vs {:?}", r.mse, r.mse_before);
+        }
+        assert!(r.cost < 0.01);
+        let none = FocusConfig {
+            horizons: vec![],
+            ..cfg
+        };
+        assert!(matches!(
+            refine(&[rec], &m, &none),
+            Err(IdentError::Refine(_))
+        ));
     }
 }

@@ -148,11 +148,16 @@ pub(crate) fn roots(p: &[f64]) -> Vec<Complex<f64>> {
     for i in 1..n {
         m[(i, i - 1)] = 1.0;
     }
+    roots_of_matrix(&m)
+}
+
+/// Eigenvalues of a real square matrix (empty when an entry is not finite or the Schur
+/// iteration fails: bounded iterations, so a hard matrix yields no roots rather than a hang).
+pub(crate) fn roots_of_matrix(m: &DMatrix<f64>) -> Vec<Complex<f64>> {
     if !m.iter().all(|v| v.is_finite()) {
         return Vec::new();
     }
-    // bounded iterations: a hard matrix yields no roots rather than a hang
-    match m.try_schur(f64::EPSILON, 10_000) {
+    match m.clone().try_schur(f64::EPSILON, 10_000) {
         Some(s) => s.complex_eigenvalues().iter().copied().collect(),
         None => Vec::new(),
     }
