@@ -181,42 +181,37 @@ pub(crate) fn subspace(
     }
     // columns: windows of 2i samples with every y measured; z = [u_p; y_p; u_f], y_f
     let (zr, fr) = (3 * i, i);
-    let mut zz = DMatrix::<f64>::zeros(zr, zr);
-    let mut yz = DMatrix::<f64>::zeros(fr, zr);
     let mut cols: Vec<(usize, usize)> = Vec::new(); // (record, window start)
-    let mut z = vec![0.0; zr];
     for (ri, (rec, ut)) in recs.iter().zip(uts).enumerate() {
         if rec.len() < 2 * i + 1 {
             continue;
         }
         for st in 0..rec.len() - 2 * i {
-            if !rec.y[st..st + 2 * i + 1].iter().all(|v| v.is_finite()) {
-                continue;
+            if rec.y[st..st + 2 * i + 1].iter().all(|v| v.is_finite())
+                && ut[st..st + 2 * i].iter().all(|v| v.is_finite())
+            {
+                cols.push((ri, st));
             }
-            for q in 0..i {
-                z[q] = ut[st + q];
-                z[i + q] = rec.y[st + q];
-                z[2 * i + q] = ut[st + i + q];
-            }
-            for a in 0..zr {
-                for b in a..zr {
-                    zz[(a, b)] += z[a] * z[b];
-                }
-                for q in 0..fr {
-                    yz[(q, a)] += rec.y[st + i + q] * z[a];
-                }
-            }
-            cols.push((ri, st));
         }
     }
     if cols.len() < 4 * zr {
         return None;
     }
-    for a in 0..zr {
-        for b in 0..a {
-            zz[(a, b)] = zz[(b, a)];
+    // the block Hankel matrices as dense columns, then Z Zᵀ and Y_f Zᵀ by matrix products
+    let zm = DMatrix::from_fn(zr, cols.len(), |a, c| {
+        let (ri, st) = cols[c];
+        match a / i {
+            0 => uts[ri][st + a],
+            1 => recs[ri].y[st + a - i],
+            _ => uts[ri][st + a - i],
         }
-    }
+    });
+    let yf = DMatrix::from_fn(fr, cols.len(), |q, c| {
+        let (ri, st) = cols[c];
+        recs[ri].y[st + i + q]
+    });
+    let zz = &zm * zm.transpose();
+    let yz = &yf * zm.transpose();
     // Θ = Y_f Zᵀ (Z Zᵀ)⁻¹ row by row; L_w = Θ[:, ..2i] is the oblique projection's operator
     let mut lw = DMatrix::<f64>::zeros(fr, 2 * i);
     for q in 0..fr {

@@ -860,19 +860,25 @@ pub fn identify(
         .map(|r| init::actuator_output(&structure, r))
         .collect();
     let mut failures = Vec::new();
-    for s in &cfg.starts {
-        let m = match s {
-            Start::Arx => init::arx(records, &uts, n)
-                .map(|(al, be)| init::canonical_start(&structure, &al, &be, &[])),
-            Start::Armax => init::armax(records, &uts, n, 8)
-                .map(|(al, be, c)| init::canonical_start(&structure, &al, &be, &c)),
-            Start::Subspace => init::subspace(records, &uts, n).map(|(a, b, k)| {
-                let mut m = structure.clone();
-                (m.n, m.a, m.b, m.k) = (n, a, b, k);
-                m
-            }),
-            Start::Template => None,
-        };
+    let make = |s: &Start| match s {
+        Start::Arx => init::arx(records, &uts, n)
+            .map(|(al, be)| init::canonical_start(&structure, &al, &be, &[])),
+        Start::Armax => init::armax(records, &uts, n, 8)
+            .map(|(al, be, c)| init::canonical_start(&structure, &al, &be, &c)),
+        Start::Subspace => init::subspace(records, &uts, n).map(|(a, b, k)| {
+            let mut m = structure.clone();
+            (m.n, m.a, m.b, m.k) = (n, a, b, k);
+            m
+        }),
+        Start::Template => None,
+    };
+    // the starts are independent regressions: computed in parallel when allowed
+    let made: Vec<Option<Model>> = if cfg.parallel {
+        cfg.starts.par_iter().map(make).collect()
+    } else {
+        cfg.starts.iter().map(make).collect()
+    };
+    for (s, m) in cfg.starts.iter().zip(made) {
         match m {
             Some(m) => starts.push((*s, params_of(&m))),
             None => failures.push(format!("{s:?}: singular regression")),
