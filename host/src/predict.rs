@@ -286,28 +286,10 @@ pub fn one_step(model: &Model, rec: &Record, x0: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// k-step-ahead predictions ŷ(t|t−k) for every sample (k ≥ 1).
+/// k-step-ahead predictions ŷ(t|t−k) for every sample (k ≥ 1): the one-step filter's
+/// x̂(t−k+1|t−k), then k − 1 open-loop steps (from x̂(0) for t < k − 1).
 pub fn k_step(model: &Model, rec: &Record, x0: &[f64], k: usize) -> Vec<f64> {
-    let k = k.max(1);
-    let s = Stepper::new(model);
-    let n = rec.len();
-    // states[t] = state before processing sample t, i.e. x̂(t|t−1).
-    let mut st = s.initial(x0, psi0(rec));
-    let mut states = Vec::with_capacity(n);
-    for t in 0..n {
-        states.push(st.clone());
-        s.step(&mut st, rec.u[t], rec.y[t], psi_at(rec, t));
-    }
-    let mut out = Vec::with_capacity(n);
-    for t in 0..n {
-        let start = (t + 1).saturating_sub(k);
-        let mut w = states[start].clone();
-        for j in start..t {
-            s.step(&mut w, rec.u[j], f64::NAN, None);
-        }
-        out.push(s.output(&w));
-    }
-    out
+    k_steps(model, rec, x0, &[k]).pop().unwrap_or_default()
 }
 
 /// Predictions at several horizons in one pass: `out[i][t] = ŷ(t|t−horizons[i])`, the same
@@ -335,10 +317,11 @@ pub fn k_steps(model: &Model, rec: &Record, x0: &[f64], horizons: &[usize]) -> V
     }
     let mut out = vec![vec![0.0; n]; hs.len()];
     for start in 0..n {
-        // sample t = start + j is predicted j + 1 steps ahead; k_step uses this pass for
-        // horizon h at t = start + h − 1, and the pass from 0 for every t < h − 1
+        // sample t = start + j is predicted j + 1 steps ahead: this pass serves horizon h at
+        // t = start + h − 1, and the pass from 0 every t < h − 1
         let mut w = states[start].clone();
-        for j in 0..kmax.min(n - start) {
+        let last = kmax.min(n - start);
+        for j in 0..last {
             let t = start + j;
             let yh = s.output(&w);
             for (o, &h) in out.iter_mut().zip(&hs) {
@@ -346,7 +329,9 @@ pub fn k_steps(model: &Model, rec: &Record, x0: &[f64], horizons: &[usize]) -> V
                     o[t] = yh;
                 }
             }
-            s.step(&mut w, rec.u[t], f64::NAN, None);
+            if j + 1 < last {
+                s.step(&mut w, rec.u[t], f64::NAN, None);
+            }
         }
     }
     out
@@ -499,10 +484,29 @@ mod tests {
         assert_eq!(pred[t], s.output(&st));
     }
 
-    /// The one-pass multi-horizon predictions equal `k_step`'s bit for bit over the whole
-    /// record, with actuator, damping and heading effects and missing samples.
+    /// The definition, spelled out: for each t, the filter up to t − k, then k − 1 open-loop
+    /// steps (from x̂(0) when t < k − 1).
+    fn k_step_by_definition(model: &Model, rec: &Record, x0: &[f64], k: usize) -> Vec<f64> {
+        let s = Stepper::new(model);
+        (0..rec.len())
+            .map(|t| {
+                let start = (t + 1).saturating_sub(k);
+                let mut st = s.initial(x0, psi0(rec));
+                for j in 0..start {
+                    s.step(&mut st, rec.u[j], rec.y[j], psi_at(rec, j));
+                }
+                for j in start..t {
+                    s.step(&mut st, rec.u[j], f64::NAN, None);
+                }
+                s.output(&st)
+            })
+            .collect()
+    }
+
+    /// The one-pass multi-horizon predictions equal the definition's bit for bit over the
+    /// whole record, with actuator, damping and heading effects and a missing sample.
     #[test]
-    fn k_steps_equal_k_step_bit_for_bit() {
+    fn k_steps_equal_the_definition_bit_for_bit() {
         let m = m4()
             .with_effect(Effect::DeadTime { samples: 2 })
             .with_effect(Effect::RateLimit { rate: 3.0 })
@@ -521,7 +525,7 @@ mod tests {
         let hs = [1, 3, 7, 20, 200];
         let all = k_steps(&m, &r, &x0, &hs);
         for (h, got) in hs.iter().zip(&all) {
-            let want = k_step(&m, &r, &x0, *h);
+            let want = k_step_by_definition(&m, &r, &x0, *h);
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(got), bits(&want), "horizon {h}");
         }

@@ -259,15 +259,10 @@ mod tests {
     /// better at 10 steps on a held-out record.
     #[test]
     fn focus_improves_long_horizon_prediction_of_a_misspecified_model() {
-        use crate::sim::{simulate, Scenario, Ship, SimEffect};
+        use crate::pem::testdata::ship_records;
         use yawcast_shared::model::EffectKind;
-        let sc = Scenario {
-            effects: vec![SimEffect::hidden(EffectKind::DeadTime, 1.0)],
-            ..Scenario::default()
-        };
-        let rec = |seed: u64| simulate(&Ship::default_lng(), &sc, seed).unwrap();
-        let est = vec![rec(1)];
-        let val = [rec(2)];
+        let est = ship_records(EffectKind::DeadTime, &[1]);
+        let val = ship_records(EffectKind::DeadTime, &[2]);
         let one = identify(&est, None, &PemConfig::default()).unwrap().model;
         let cfg = FocusConfig {
             horizons: vec![10],

@@ -245,31 +245,20 @@ pub(crate) fn subspace(
             sm[(r, a)] = v * sc;
         }
     }
-    let state = |ri: usize, st: usize| -> DVector<f64> {
-        let (rec, ut) = (&recs[ri], &uts[ri]);
-        DVector::from_iterator(
-            n,
-            (0..n).map(|r| {
-                let mut v = 0.0;
-                for q in 0..i {
-                    v += sm[(r, q)] * ut[st + q] + sm[(r, i + q)] * rec.y[st + q];
-                }
-                v
-            }),
-        )
-    };
+    // the state sequence, one column per window
+    let xs = &sm * zm.rows(0, 2 * i);
     // least squares on consecutive states: y = C x + e, x⁺ = A x + B ũ + w
     let m = n + 1;
     let mut g = DMatrix::<f64>::zeros(m, m);
     let mut gy = DVector::<f64>::zeros(m);
     let mut gx = DMatrix::<f64>::zeros(m, n);
     let mut pairs = Vec::new();
-    for w in cols.windows(2) {
-        let ((r0, s0), (r1, s1)) = (w[0], w[1]);
+    for c in 1..cols.len() {
+        let ((r0, s0), (r1, s1)) = (cols[c - 1], cols[c]);
         if r0 != r1 || s1 != s0 + 1 {
             continue;
         }
-        let (x0, x1) = (state(r0, s0), state(r1, s1));
+        let (x0, x1) = (xs.column(c - 1).into_owned(), xs.column(c).into_owned());
         let (u, y) = (uts[r0][s0 + i], recs[r0].y[s0 + i]);
         let phi = DVector::from_iterator(m, x0.iter().copied().chain([u]));
         g += &phi * phi.transpose();

@@ -89,3 +89,13 @@ pub(crate) fn record(seed: u64, len: usize) -> Record {
     let u = prbs(&mut rng, len, &[5.0, 10.0, 20.0]);
     simulate_innovations(&truth(), &u, 0.05, &mut rng, &format!("seed{seed}"), false)
 }
+
+/// Records of the built-in ship with `kind` hidden at full strength, one per seed.
+pub(crate) fn ship_records(kind: yawcast_shared::model::EffectKind, seeds: &[u64]) -> Vec<Record> {
+    use crate::sim::{simulate_many, Scenario, Ship, SimEffect};
+    let sc = Scenario {
+        effects: vec![SimEffect::hidden(kind, 1.0)],
+        ..Scenario::default()
+    };
+    simulate_many(&Ship::default_lng(), &sc, seeds).unwrap()
+}

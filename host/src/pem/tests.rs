@@ -286,13 +286,8 @@ fn warm_start_converges_to_the_same_optimum() {
 /// (a different basin), with better long-horizon predictions on a held-out record.
 #[test]
 fn subspace_start_reaches_lower_one_step_minima_on_a_dead_time_ship() {
-    use crate::sim::{simulate, Scenario, Ship, SimEffect};
     use yawcast_shared::model::EffectKind;
-    let sc = Scenario {
-        effects: vec![SimEffect::hidden(EffectKind::DeadTime, 1.0)],
-        ..Scenario::default()
-    };
-    let rec = |seed: u64| simulate(&Ship::default_lng(), &sc, seed).unwrap();
+    let rec = |seed: u64| testdata::ship_records(EffectKind::DeadTime, &[seed]).remove(0);
     let arx_only = PemConfig {
         starts: vec![Start::Arx, Start::Armax],
         ..PemConfig::default()
@@ -336,13 +331,8 @@ fn subspace_start_reaches_lower_one_step_minima_on_a_dead_time_ship() {
 /// so the search prefers the minimum from the other starts, whose predictor does.
 #[test]
 fn a_predictor_that_never_forgets_its_initial_state_loses_to_one_that_does() {
-    use crate::sim::{simulate_many, Scenario, Ship, SimEffect};
     use yawcast_shared::model::EffectKind;
-    let sc = Scenario {
-        effects: vec![SimEffect::hidden(EffectKind::Bias, 1.0)],
-        ..Scenario::default()
-    };
-    let est = simulate_many(&Ship::default_lng(), &sc, &[1, 2, 3]).unwrap();
+    let est = testdata::ship_records(EffectKind::Bias, &[1, 2, 3]);
     let only = PemConfig {
         starts: vec![Start::Subspace],
         ..PemConfig::default()
