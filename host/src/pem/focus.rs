@@ -232,14 +232,14 @@ pub fn refine(
             }
         }
     }
-    let model = with_params(start, &params);
-    let mse = mse_per(
-        &residuals(&model, recs, &hs).unwrap_or_default(),
-        hs.len(),
-        m,
-    );
+    // e holds the refined model's residuals, weighted: unweigh them per horizon
+    let mse: Vec<f64> = mse_per(&e, hs.len(), m)
+        .iter()
+        .zip(&w)
+        .map(|(v, wi)| v / (wi * wi))
+        .collect();
     Ok(FocusReport {
-        model,
+        model: with_params(start, &params),
         horizons: hs,
         mse_before,
         mse,
