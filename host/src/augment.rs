@@ -5,11 +5,14 @@
 //!
 //! 1. **Baseline.** The input structure (with whatever effects it already carries) is
 //!    re-identified on the estimation records, so the comparison with the candidate is fair:
-//!    both have seen the same data.
+//!    both have seen the same data. Baseline and candidate are each identified as
+//!    [`pem::identify`] does (its starts plus warm starts, and its choice between minima that
+//!    predict one step equally well, [`pem::choose`]); the searches *inside* step 2 compare
+//!    one-step costs and take the lowest minimum, as do ΔAIC and ΔBIC.
 //! 2. **Candidate.** The effect is appended (stacked on the model's effects).
 //!    - *Linear-gain effects* (bias, gyro bias, asymmetry, nonlinear damping, wind, current):
-//!      PEM ([`pem::identify`]) from the ARX, ARMAX and subspace starts and from the input
-//!      model with the new gain at zero; the lowest estimation cost wins.
+//!      PEM from the ARX, ARMAX and subspace starts, from the input model with the new gain
+//!      at zero and from the baseline with the new gain at zero.
 //!    - *Actuator effects* (dead time d, slew limit ρ, angle limit δ_max): a grid of the
 //!      structural parameter (d = 1..=[`MAX_DEAD_TIME`] samples; ρ on a log grid over
 //!      0.5–20 °/s, which covers real steering gears' 2.3–9 °/s; δ_max over the quantiles
@@ -18,7 +21,8 @@
 //!      warm-started re-identification (θ frozen without the effect can miss a sharp optimum);
 //!      the best few of each ranking are re-identified fully, and a continuous parameter is
 //!      refined by golden-section search between the neighbours of the best, each point
-//!      re-identified from a warm start.
+//!      re-identified from a warm start; the best value's structure is then identified as
+//!      the baseline was.
 //! 3. **Held-out judgement.** Fit % per horizon on the validation records of the input model
 //!    (`before`), the baseline and the candidate (`after`). When no validation record is
 //!    given, the last third of each estimation record is held out (or, for short records,
@@ -327,6 +331,9 @@ fn pem_cfg(cfg: &AugmentConfig, n: usize, p: usize) -> PemConfig {
         r: fit_len(&cfg.pem.r),
         nominal: fit_len(&cfg.pem.nominal),
         parallel: cfg.parallel && cfg.pem.parallel,
+        // the grid, the golden-section search and ΔAIC/ΔBIC compare one-step costs: each
+        // identification must end at its lowest minimum, not at the better multi-step one
+        select_horizons: Vec::new(),
         ..cfg.pem.clone()
     }
 }
@@ -352,6 +359,24 @@ fn reidentify(
         }
     }
     fresh
+}
+
+/// The final identification of a compared structure (the baseline, the candidate), as
+/// [`pem::identify`] does it: ARX, ARMAX, subspace, `template` and `extra` as starts, and
+/// among their minima the lowest cost unless another predicts one step as well and several
+/// steps significantly better ([`pem::choose`]). Falls back to [`reidentify`].
+fn reidentify_final(
+    est: &[Record],
+    template: &Model,
+    extra: &[Model],
+    cfg: &AugmentConfig,
+) -> Result<PemReport, IdentError> {
+    let pc = PemConfig {
+        select_horizons: cfg.pem.select_horizons.clone(),
+        ..pem_cfg(cfg, template.n, n_params(template))
+    };
+    let extra: Vec<Model> = extra.iter().filter(|m| m.is_stable()).cloned().collect();
+    pem::identify_with(est, Some(template), &extra, &pc).or_else(|_| reidentify(est, template, cfg))
 }
 
 /// A warm-started re-identification from `start` (falls back to a fresh one).
@@ -709,7 +734,7 @@ pub fn augment(
     }
 
     // baseline: the input structure re-identified on the same estimation records
-    let base = reidentify(&est_part, model, cfg)?;
+    let base = reidentify_final(&est_part, model, &[], cfg)?;
     let before = evaluate(model, &val_part, &horizons, cfg.parallel);
     let baseline = evaluate(&base.model, &val_part, &horizons, cfg.parallel);
 
@@ -723,22 +748,21 @@ pub fn augment(
                     c.reidentified,
                     describe(&Effect::zero(kind, c.value), model.ts)
                 );
-                (Some(c.rep), note)
+                // the chosen value's structure identified as the baseline was
+                let fin = reidentify_final(&est_part, &c.rep.model, &[], cfg).unwrap_or(c.rep);
+                (Some(fin), note)
             }
             None => (None, "no usable grid value".to_string()),
         }
     } else {
         let t = model.clone().with_effect(Effect::zero(kind, 0.0));
-        let mut best = reidentify(&est_part, &t, cfg).ok();
-        // nested: from the baseline with the new gain at zero the candidate can only do
-        // better on the estimation records than the baseline does
+        // nested: from the baseline with the new gain at zero the candidate reaches the
+        // baseline's minimum or a lower one on the estimation records
         let nested = base.model.clone().with_effect(Effect::zero(kind, 0.0));
-        if let Ok(w) = reidentify_warm(&est_part, &nested, cfg) {
-            if best.as_ref().map_or(true, |b| w.cost < b.cost) {
-                best = Some(w);
-            }
-        }
-        (best, String::new())
+        (
+            reidentify_final(&est_part, &t, &[nested], cfg).ok(),
+            String::new(),
+        )
     };
     let Some(cand) = cand else {
         let candidate = model.clone().with_effect(Effect::zero(kind, 1.0));

@@ -531,10 +531,14 @@ fn identify_average_export_compare_chain() {
         "aic",
         "bic",
         "fit",
+        "start",
+        "start_choice",
     ] {
         assert!(v.get(k).is_some(), "identify JSON lacks `{k}`");
     }
     assert!(v["fit"]["5"].as_f64().unwrap() > 95.0, "{v}");
+    // a linear record: every start ends in the one minimum, the lowest cost is taken
+    assert!(v["start_choice"].is_null(), "{v}");
     let secs = v["identify_s"].as_f64().unwrap();
     assert!(secs > 0.0 && secs < 60.0, "{v}");
 
@@ -1041,9 +1045,8 @@ fn identify_focus_refines_on_k_step_errors_and_pins_its_json() {
     use yawcast::sim::SimEffect;
     use yawcast_shared::model::EffectKind;
     let d = scratch("focus");
-    // a record with a hidden 2 s dead time whose lowest one-step minimum (reached from the
-    // ARX start) predicts poorly over 10 steps: `yawcast simulate --seed 101 --effect
-    // dead-time`, validated on seed 201 (the peers benchmark's dead-time/s1)
+    // a record with a hidden 2 s dead time (`yawcast simulate --seed 101 --effect
+    // dead-time`, validated on seed 201: the peers benchmark's dead-time/s1)
     let recs = sim_csvs(
         &d,
         "trial",
@@ -1068,10 +1071,29 @@ fn identify_focus_refines_on_k_step_errors_and_pins_its_json() {
         assert_eq!(code(&o), 0, "{}", stderr(&o));
         stdout(&o)
     };
-    ident(&[], &d.join("plain.json"));
-    let out = ident(&["--focus", "10"], &d.join("focus.json"));
+    // order 4: the lowest one-step minimum (ARMAX start) predicts poorly over 10 steps; the
+    // subspace minimum is as good one step ahead and is taken (measured 86.6 → 89.2 %)
+    let chosen = ident(&[], &d.join("plain4.json"));
+    assert!(chosen.contains("subspace minimum taken"), "{chosen}");
+    let p4 = read(&d.join("plain4.json"));
+    assert_eq!(p4["start"], "subspace");
+    let c = &p4["start_choice"];
+    assert_eq!(c["lowest"], "armax");
+    assert_eq!(c["horizons"], serde_json::json!([5, 10, 20]));
+    let num = |k: &str| c[k].as_f64().unwrap_or_else(|| panic!("{k}: {c}"));
+    assert!(num("cost_ratio") > 1.0 && num("z") < 1.645, "{c}");
+    assert!(
+        num("multi_step_ratio") < 1.0 && num("multi_step_z") < -1.645,
+        "{c}"
+    );
+    // a model too small for the ship (order 2): --focus pays (measured 83.0 → 85.9 %)
+    ident(&["--order", "2"], &d.join("plain.json"));
+    let out = ident(&["--order", "2", "--focus", "10"], &d.join("focus.json"));
     assert!(out.contains("focus on 10-step errors"), "{out}");
-    let multi = ident(&["--focus", "20,1,5,10"], &d.join("multi.json"));
+    let multi = ident(
+        &["--order", "2", "--focus", "20,1,5,10"],
+        &d.join("multi.json"),
+    );
     assert!(multi.contains("focus on 1,5,10,20-step errors"), "{multi}");
     let (plain, focus, many) = (
         read(&d.join("plain.json")),
@@ -1085,9 +1107,8 @@ fn identify_focus_refines_on_k_step_errors_and_pins_its_json() {
     assert_eq!(many["focus"], 20);
     assert_eq!(many["focus_horizons"], serde_json::json!([1, 5, 10, 20]));
     let f10 = |v: &serde_json::Value| v["fit"]["10"].as_f64().unwrap();
-    // measured 86.6 → 89.3 %
     assert!(
-        f10(&focus) > f10(&plain) + 1.0,
+        f10(&focus) > f10(&plain) + 1.5,
         "10-step fit {} → {}",
         f10(&plain),
         f10(&focus)

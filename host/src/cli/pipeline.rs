@@ -158,6 +158,10 @@ pub struct IdentifySummary {
     pub focus: Option<usize>,
     /// Every horizon of `--focus`, ascending (empty: plain one-step PEM).
     pub focus_horizons: Vec<usize>,
+    /// The start whose minimum was taken (`arx`, `armax`, `subspace`, `template`).
+    pub start: pem::Start,
+    /// Set when that minimum is not the lowest-cost one: the test that chose it.
+    pub start_choice: Option<pem::choose::StartChoice>,
 }
 
 /// Runs `identify`.
@@ -261,6 +265,9 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
         rep.iterations,
         rep.reliability
     );
+    if let Some(c) = &rep.choice {
+        println!("{}", c.describe(rep.start));
+    }
     print_params(&rep.names, &all_params(&model), &rep.std_pct);
     let fit = if val.is_empty() {
         BTreeMap::new()
@@ -306,6 +313,8 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
         identify_s,
         focus: horizons.last().copied(),
         focus_horizons: horizons,
+        start: rep.start,
+        start_choice: rep.choice.clone(),
     })
 }
 

@@ -16,6 +16,7 @@
 //! `σ̂² = Σε²/(N − p)`. The paper's reliability rule is reported: any STD% above 10 makes the
 //! model unreliable, above 50 unusable.
 
+pub mod choose;
 pub mod focus;
 mod init;
 pub(crate) mod poly;
@@ -75,6 +76,9 @@ pub struct PemConfig {
     pub starts: Vec<Start>,
     /// Evaluate records in parallel (rayon).
     pub parallel: bool,
+    /// Horizons (samples) that decide between minima whose one-step costs do not differ
+    /// significantly (see [`choose`]); empty: the lowest cost always wins.
+    pub select_horizons: Vec<usize>,
 }
 
 impl Default for PemConfig {
@@ -88,6 +92,7 @@ impl Default for PemConfig {
             tol: 1e-8,
             starts: vec![Start::Arx, Start::Armax, Start::Subspace],
             parallel: true,
+            select_horizons: vec![5, 10, 20],
         }
     }
 }
@@ -165,7 +170,8 @@ pub struct PemReport {
     pub x0: Vec<Vec<f64>>,
     /// Parameter names, in the order of `std`, `std_pct`, `cov`.
     pub names: Vec<String>,
-    /// V(θ) at the optimum (including the penalty).
+    /// V(θ) at the optimum (including the penalty); see `choice` when that is not the
+    /// lowest minimum the starts reached.
     pub cost: f64,
     /// Residual variance Σε²/(N − p).
     pub sigma2: f64,
@@ -181,9 +187,10 @@ pub struct PemReport {
     pub termination: Termination,
     /// Which start won.
     pub start: Start,
-    /// Akaike's criterion `N ln(Σε²/N) + 2p + N(ln 2π + 1)`.
+    /// Akaike's criterion `N ln(Σε²/N) + 2p + N(ln 2π + 1)`, Σε² of the lowest minimum
+    /// any start reached (the structure's maximum likelihood).
     pub aic: f64,
-    /// Bayesian criterion `N ln(Σε²/N) + p ln N + N(ln 2π + 1)`.
+    /// Bayesian criterion `N ln(Σε²/N) + p ln N + N(ln 2π + 1)`, Σε² as for `aic`.
     pub bic: f64,
     /// Samples used (measured y, all records).
     pub samples: usize,
@@ -195,6 +202,9 @@ pub struct PemReport {
     pub r: Vec<f64>,
     /// One-step fit % per record (with its x̂(0)).
     pub fit: Vec<f64>,
+    /// Set when the winning minimum is not the lowest-cost one: why (see [`choose`]).
+    #[serde(default)]
+    pub choice: Option<choose::StartChoice>,
 }
 
 impl PemReport {
@@ -828,6 +838,17 @@ pub fn identify(
     template: Option<&Model>,
     cfg: &PemConfig,
 ) -> Result<PemReport, IdentError> {
+    identify_with(records, template, &[], cfg)
+}
+
+/// [`identify`] with `extra` models of the template's structure as further starts (warm
+/// starts that compete with the others under the same rule).
+pub(crate) fn identify_with(
+    records: &[Record],
+    template: Option<&Model>,
+    extra: &[Model],
+    cfg: &PemConfig,
+) -> Result<PemReport, IdentError> {
     let n = cfg.order;
     if !(2..=8).contains(&n) {
         return Err(IdentError::Order(n));
@@ -884,9 +905,12 @@ pub fn identify(
             None => failures.push(format!("{s:?}: singular regression")),
         }
     }
-    if let Some(t) = template {
+    for t in template.into_iter().chain(extra) {
         if t.n == n && t.theta().iter().any(|v| *v != 0.0) {
-            starts.push((Start::Template, params_of(t)));
+            let p = params_of(t);
+            if p.len() == prob.lay.p {
+                starts.push((Start::Template, p));
+            }
         }
     }
     run_starts(&prob, starts, cfg, failures)
@@ -1007,29 +1031,116 @@ fn run_starts(
             failures.push(format!("{s:?}: non-finite predictions"));
         }
     }
-    // The lowest cost wins among the minima whose predictor forgets its initial state within
-    // the records (see `forgets`); only when none does, the lowest cost overall.
+    // Only minima whose predictor forgets its initial state within the records compete
+    // (see `forgets`), unless none does.
     let forgetting: Vec<bool> = found
         .iter()
         .map(|(_, r)| forgets(&prob.model(&r.pt.params), prob.recs))
         .collect();
     let any = forgetting.iter().any(|f| *f);
-    let best = found
+    let pool: Vec<(Start, Search)> = found
         .into_iter()
         .zip(forgetting)
         .filter(|(_, f)| *f || !any)
         .map(|(r, _)| r)
-        .reduce(|a, b| {
-            if prob.total(&b.1.pt) < prob.total(&a.1.pt) {
-                b
-            } else {
-                a
-            }
-        });
-    let Some((start, search)) = best else {
+        .collect();
+    let Some(lowest) = (0..pool.len()).reduce(|a, b| {
+        if prob.total(&pool[b].1.pt) < prob.total(&pool[a].1.pt) {
+            b
+        } else {
+            a
+        }
+    }) else {
         return Err(IdentError::AllStartsFailed(failures.join(", ")));
     };
-    report(prob, start, search)
+    let (pick, choice) = choose_minimum(prob, &pool, lowest, &cfg.select_horizons);
+    // AIC and BIC belong to the structure: its maximum likelihood is the lowest minimum
+    let ml_sse = pool[lowest].1.pt.sse;
+    let (start, search) = pool.into_iter().nth(pick).expect("index from the pool");
+    let mut rep = report(prob, start, search, ml_sse)?;
+    rep.choice = choice;
+    Ok(rep)
+}
+
+/// Among the minima whose one-step cost is not significantly above the lowest's
+/// ([`choose::dm_z`] below [`choose::Z_EQUAL`]) and whose k-step errors over `horizons` are
+/// significantly below the lowest's, the one with the lowest mean relative k-step error;
+/// `(lowest, None)` when there is none.
+fn choose_minimum(
+    prob: &Problem<'_>,
+    pool: &[(Start, Search)],
+    lowest: usize,
+    horizons: &[usize],
+) -> (usize, Option<choose::StartChoice>) {
+    if pool.len() < 2 || horizons.is_empty() {
+        return (lowest, None);
+    }
+    let mut hs: Vec<usize> = horizons.iter().map(|h| (*h).max(1)).collect();
+    hs.sort_unstable();
+    hs.dedup();
+    // one-step errors and k-step errors per horizon, per record
+    let errors = |pt: &Point| -> (Vec<Vec<f64>>, Vec<Vec<Vec<f64>>>) {
+        let m = prob.model(&pt.params);
+        let mut one = Vec::with_capacity(prob.recs.len());
+        let mut multi = vec![Vec::with_capacity(prob.recs.len()); hs.len()];
+        for (r, x) in prob.recs.iter().zip(&pt.x0) {
+            let err = |p: Vec<f64>| -> Vec<f64> { r.y.iter().zip(p).map(|(y, p)| y - p).collect() };
+            one.push(err(predict::one_step(&m, r, x)));
+            for (slot, p) in multi.iter_mut().zip(predict::k_steps(&m, r, x, &hs)) {
+                slot.push(err(p));
+            }
+        }
+        (one, multi)
+    };
+    let all: Vec<_> = pool.iter().map(|(_, s)| errors(&s.pt)).collect();
+    let base = &all[lowest];
+    let base_mse: Vec<f64> = base.1.iter().map(|e| choose::mse(e)).collect();
+    let base_total = prob.total(&pool[lowest].1.pt);
+    let mut best: Option<choose::StartChoice> = None;
+    let mut pick = lowest;
+    for (i, (one, multi)) in all.iter().enumerate() {
+        if i == lowest {
+            continue;
+        }
+        let pt = &pool[i].1.pt;
+        // a start that ended in the lowest minimum itself (to well within the sampling
+        // spread): its tiny differences may test significant but mean nothing
+        if prob.total(pt) - base_total <= 1e-6 * base_total {
+            continue;
+        }
+        let count = pt.count.max(1) as f64;
+        // the penalty's share of the cost difference (0 for plain PEM)
+        let extra =
+            (prob.pen.value(&pt.params) - prob.pen.value(&pool[lowest].1.pt.params)) / count;
+        let z = choose::dm_z(one, &base.0, extra);
+        // NaN (no usable samples) never qualifies
+        if z.is_nan() || z >= choose::Z_EQUAL {
+            continue;
+        }
+        let ratio = multi
+            .iter()
+            .zip(&base_mse)
+            .map(|(e, b)| choose::mse(e) / b)
+            .sum::<f64>()
+            / hs.len() as f64;
+        let zm = choose::dm_z_of(
+            &choose::scaled_differences(multi, &base.1),
+            0.0,
+            hs.last().copied().unwrap_or(1),
+        );
+        if zm < -choose::Z_EQUAL && best.as_ref().map_or(true, |b| ratio < b.multi_step_ratio) {
+            best = Some(choose::StartChoice {
+                lowest: pool[lowest].0,
+                cost_ratio: prob.total(pt) / base_total,
+                z,
+                horizons: hs.clone(),
+                multi_step_ratio: ratio,
+                multi_step_z: zm,
+            });
+            pick = i;
+        }
+    }
+    (pick, best)
 }
 
 /// Whether the one-step predictor A − KC forgets its initial state within the records: its
@@ -1046,7 +1157,14 @@ fn forgets(model: &Model, recs: &[Record]) -> bool {
     len * rho.ln() <= 0.01f64.ln()
 }
 
-fn report(prob: &Problem<'_>, start: Start, s: Search) -> Result<PemReport, IdentError> {
+/// The report of the minimum `s`; AIC and BIC from `ml_sse`, the lowest Σε² any start
+/// reached (= `s.pt.sse` unless a minimum other than the lowest was chosen).
+fn report(
+    prob: &Problem<'_>,
+    start: Start,
+    s: Search,
+    ml_sse: f64,
+) -> Result<PemReport, IdentError> {
     let p = prob.lay.p;
     let model = prob.model(&s.pt.params);
     if !model.is_stable() {
@@ -1075,7 +1193,7 @@ fn report(prob: &Problem<'_>, start: Start, s: Search) -> Result<PemReport, Iden
         })
         .collect();
     let nf = nsamp as f64;
-    let v = (sse / nf).max(f64::MIN_POSITIVE);
+    let v = (ml_sse.min(sse) / nf).max(f64::MIN_POSITIVE);
     let base = nf * v.ln() + nf * ((2.0 * std::f64::consts::PI).ln() + 1.0);
     let fit = prob
         .recs
@@ -1104,6 +1222,7 @@ fn report(prob: &Problem<'_>, start: Start, s: Search) -> Result<PemReport, Iden
         fit,
         x0: s.pt.x0,
         model,
+        choice: None,
     })
 }
 

@@ -288,16 +288,21 @@ fn warm_start_converges_to_the_same_optimum() {
 fn subspace_start_reaches_lower_one_step_minima_on_a_dead_time_ship() {
     use yawcast_shared::model::EffectKind;
     let rec = |seed: u64| testdata::ship_records(EffectKind::DeadTime, &[seed]).remove(0);
+    // the lowest cost wins here: this is about the minima the starts reach
+    let lowest = PemConfig {
+        select_horizons: vec![],
+        ..PemConfig::default()
+    };
     let arx_only = PemConfig {
         starts: vec![Start::Arx, Start::Armax],
-        ..PemConfig::default()
+        ..lowest.clone()
     };
     let mut lower = 0;
     for seed in 1..=4u64 {
         let est = [rec(seed)];
         let val = rec(100 + seed);
         let old = identify(&est, None, &arx_only).unwrap();
-        let new = identify(&est, None, &PemConfig::default()).unwrap();
+        let new = identify(&est, None, &lowest).unwrap();
         let f = |m: &Model| predict::fit_at(m, &val, Horizon::Steps(10));
         println!(
             "seed {seed}: cost {:.5} → {:.5} ({:?}), held-out 10-step {:.2} → {:.2}",
@@ -350,4 +355,59 @@ fn a_predictor_that_never_forgets_its_initial_state_loses_to_one_that_does() {
     assert!(rho_all.powf(len) <= 0.01, "{rho_all}");
     assert!(sub.cost < all.cost);
     assert_ne!(all.start, Start::Subspace);
+}
+
+/// The same ship with a dead time, on seeds where the ARX/ARMAX minimum has the lowest
+/// one-step cost by 1.3–1.4 % but predicts poorly beyond one step: the difference in one-step
+/// cost is within its sampling spread, the subspace minimum's 5/10/20-step errors are
+/// significantly smaller, so it is taken — and predicts a held-out record better. On the
+/// clean ship the starts agree (or the lowest is also the better predictor): no choice.
+#[test]
+fn an_equally_good_one_step_minimum_that_predicts_further_wins() {
+    use yawcast_shared::model::EffectKind;
+    let rec = |kind, seed: u64| testdata::ship_records(kind, &[seed]).remove(0);
+    let lowest = PemConfig {
+        select_horizons: vec![],
+        ..PemConfig::default()
+    };
+    for seed in [101u64, 109] {
+        let est = [rec(EffectKind::DeadTime, seed)];
+        let val = rec(EffectKind::DeadTime, seed + 100);
+        let old = identify(&est, None, &lowest).unwrap();
+        let new = identify(&est, None, &PemConfig::default()).unwrap();
+        let f = |m: &Model| predict::fit_at(m, &val, Horizon::Steps(10));
+        let c = new.choice.clone().expect("a choice");
+        println!(
+            "seed {seed}: {:?} → {:?}, held-out 10-step {:.2} → {:.2}; {}",
+            old.start,
+            new.start,
+            f(&old.model),
+            f(&new.model),
+            c.describe(new.start)
+        );
+        assert_eq!(new.start, Start::Subspace);
+        assert_eq!(c.lowest, old.start);
+        assert!((new.cost / old.cost - c.cost_ratio).abs() < 1e-12);
+        assert!(c.cost_ratio > 1.005 && c.z < choose::Z_EQUAL, "{c:?}");
+        assert!(
+            c.multi_step_z < -choose::Z_EQUAL && c.multi_step_ratio < 0.9,
+            "{c:?}"
+        );
+        assert!(f(&new.model) > f(&old.model) + 1.0);
+    }
+    for seed in 1..=3u64 {
+        let est = [testdata::ship_records(EffectKind::Bias, &[seed]).remove(0)];
+        let clean = crate::sim::simulate_many(
+            &crate::sim::Ship::default_lng(),
+            &crate::sim::Scenario::default(),
+            &[seed],
+        )
+        .unwrap();
+        for recs in [&est[..], &clean[..]] {
+            let a = identify(recs, None, &lowest).unwrap();
+            let b = identify(recs, None, &PemConfig::default()).unwrap();
+            assert!(b.choice.is_none(), "seed {seed}: {:?}", b.choice);
+            assert_eq!(a.model, b.model);
+        }
+    }
 }
