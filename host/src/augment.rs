@@ -246,11 +246,7 @@ fn evaluate(model: &Model, val: &[Record], horizons: &[Horizon], parallel: bool)
         }
         (fits, u10, usim, res)
     };
-    let per: Vec<_> = if parallel {
-        val.par_iter().map(one).collect()
-    } else {
-        val.iter().map(one).collect()
-    };
+    let per: Vec<_> = crate::par::map(val, parallel, one);
     let keys: Vec<String> = horizons.iter().map(Horizon::key).collect();
     let mean = crate::compare::mean_fits(per.iter().map(|p| &p.0), &keys);
     let finite = mean.values().all(|v| v.is_finite());
@@ -480,11 +476,7 @@ fn choose_actuator(
     }
     let score = |m: &Model| -> Vec<f64> {
         let f = |v: &f64| frozen_cost(&m.clone().with_effect(Effect::zero(kind, *v)), est);
-        if cfg.parallel {
-            grid.par_iter().map(f).collect()
-        } else {
-            grid.iter().map(f).collect()
-        }
+        crate::par::map(&grid, cfg.parallel, f)
     };
     let mut pick: Vec<usize> = Vec::new();
     let add_best = |c: &[f64], pick: &mut Vec<usize>| {
@@ -508,11 +500,7 @@ fn choose_actuator(
         let m = base.clone().with_effect(Effect::zero(kind, *v));
         reidentify_warm(est, &m, cfg).map_or(f64::INFINITY, |r| r.cost)
     };
-    let warm: Vec<f64> = if cfg.parallel {
-        grid.par_iter().map(warm_cost).collect()
-    } else {
-        grid.iter().map(warm_cost).collect()
-    };
+    let warm: Vec<f64> = crate::par::map(&grid, cfg.parallel, warm_cost);
     add_best(&warm, &mut pick);
     let warm_scanned = grid.len();
     let fit_at = |v: f64| -> Option<PemReport> {
@@ -526,11 +514,8 @@ fn choose_actuator(
         }
         best
     };
-    let tried: Vec<(usize, Option<PemReport>)> = if cfg.parallel {
-        pick.par_iter().map(|&i| (i, fit_at(grid[i]))).collect()
-    } else {
-        pick.iter().map(|&i| (i, fit_at(grid[i]))).collect()
-    };
+    let tried: Vec<(usize, Option<PemReport>)> =
+        crate::par::map(&pick, cfg.parallel, |&i| (i, fit_at(grid[i])));
     let mut reidentified = tried.len() + warm_scanned;
     let (bi, brep) = tried
         .into_iter()

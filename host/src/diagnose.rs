@@ -50,7 +50,6 @@ use std::collections::BTreeMap;
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rayon::prelude::*;
 use serde::Serialize;
 use thiserror::Error;
 use yawcast_shared::model::EffectKind;
@@ -391,11 +390,7 @@ impl<'a> Set<'a> {
             }
             q
         };
-        if parallel {
-            cands.par_iter().map(one).collect()
-        } else {
-            cands.iter().map(one).collect()
-        }
+        crate::par::map(cands, parallel, one)
     }
 
     /// SSE of the base model at horizon h.
@@ -1113,11 +1108,7 @@ fn world(
             n: tn,
         }
     };
-    if parallel {
-        grids.par_iter().map(one).collect()
-    } else {
-        grids.iter().map(one).collect()
-    }
+    crate::par::map(grids, parallel, one)
 }
 
 /// Null replicates of `D` for every kind: parametric bootstrap of the whole procedure. The
@@ -1163,11 +1154,7 @@ fn bootstrap(
             .map(|w| w.d)
             .collect()
     };
-    let per: Vec<Vec<f64>> = if parallel {
-        (0..reps).into_par_iter().map(one).collect()
-    } else {
-        (0..reps).map(one).collect()
-    };
+    let per: Vec<Vec<f64>> = crate::par::map_range(reps, parallel, one);
     (0..grids.len())
         .map(|k| per.iter().map(|v| v[k]).collect())
         .collect()
@@ -1502,6 +1489,7 @@ fn frozen_gain(
 mod tests {
     use super::*;
     use crate::sim::{simulate, NoiseSpec, Scenario, Ship, SimEffect};
+    use rayon::prelude::*;
 
     fn noise() -> NoiseSpec {
         NoiseSpec {

@@ -13,6 +13,7 @@ pub mod hil;
 pub mod merge;
 pub mod model;
 pub mod nmea;
+mod par;
 pub mod pem;
 pub mod predict;
 pub mod report;

@@ -23,7 +23,6 @@ pub(crate) mod poly;
 pub(crate) mod sens;
 
 use nalgebra::{DMatrix, DVector};
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -522,15 +521,17 @@ impl Problem<'_> {
         pt.sse + self.pen.value(&pt.params)
     }
 
+    /// Whether records are evaluated in parallel (allowed, and more than one).
+    fn parallel_records(&self) -> bool {
+        self.parallel && self.recs.len() > 1
+    }
+
     /// Σε² and count at (params, x0).
     fn sse(&self, params: &[f64], x0: &[Vec<f64>]) -> (f64, usize) {
         let m = self.model(params);
-        let one = |(r, x): (&Record, &Vec<f64>)| sens::sse(&m, r, x);
-        let parts: Vec<sens::SseOnly> = if self.parallel && self.recs.len() > 1 {
-            self.recs.par_iter().zip(x0.par_iter()).map(one).collect()
-        } else {
-            self.recs.iter().zip(x0.iter()).map(one).collect()
-        };
+        let parts = crate::par::map_range(self.recs.len(), self.parallel_records(), |i| {
+            sens::sse(&m, &self.recs[i], &x0[i])
+        });
         let sse = parts.iter().map(|s| s.sse).sum::<f64>();
         let count = parts.iter().map(|s| s.count).sum();
         (if sse.is_finite() { sse } else { f64::INFINITY }, count)
@@ -540,17 +541,12 @@ impl Problem<'_> {
     fn jac(&self, params: &[f64], x0: &[Vec<f64>]) -> Vec<Accum> {
         let m = self.model(params);
         let q = self.lay.q();
-        let one = |(r, x): (&Record, &Vec<f64>)| {
+        crate::par::map_range(self.recs.len(), self.parallel_records(), |i| {
             let mut acc = Accum::new(q);
-            sens::pass(&m, &self.lay, r, x, &mut acc);
+            sens::pass(&m, &self.lay, &self.recs[i], &x0[i], &mut acc);
             acc.finish();
             acc
-        };
-        if self.parallel && self.recs.len() > 1 {
-            self.recs.par_iter().zip(x0.par_iter()).map(one).collect()
-        } else {
-            self.recs.iter().zip(x0.iter()).map(one).collect()
-        }
+        })
     }
 
     /// A point at `params` with x̂(0) solved by least squares (two Gauss–Newton passes on
@@ -894,11 +890,7 @@ pub(crate) fn identify_with(
         Start::Template => None,
     };
     // the starts are independent regressions: computed in parallel when allowed
-    let made: Vec<Option<Model>> = if cfg.parallel {
-        cfg.starts.par_iter().map(make).collect()
-    } else {
-        cfg.starts.iter().map(make).collect()
-    };
+    let made: Vec<Option<Model>> = crate::par::map(&cfg.starts, cfg.parallel, make);
     for (s, m) in cfg.starts.iter().zip(made) {
         match m {
             Some(m) => starts.push((*s, params_of(&m))),
@@ -1012,17 +1004,9 @@ fn run_starts(
         })
         .collect();
     // the searches are independent: in parallel when allowed (same result either way)
-    let searched: Vec<(Start, Search)> = if cfg.parallel {
-        usable
-            .into_par_iter()
-            .map(|(s, p)| (s, prob.search(p, cfg.max_iter, cfg.tol)))
-            .collect()
-    } else {
-        usable
-            .into_iter()
-            .map(|(s, p)| (s, prob.search(p, cfg.max_iter, cfg.tol)))
-            .collect()
-    };
+    let searched: Vec<(Start, Search)> = crate::par::map_owned(usable, cfg.parallel, |(s, p)| {
+        (s, prob.search(p, cfg.max_iter, cfg.tol))
+    });
     let mut found: Vec<(Start, Search)> = Vec::new();
     for (s, res) in searched {
         if res.pt.sse.is_finite() {

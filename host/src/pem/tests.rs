@@ -6,6 +6,7 @@ use super::*;
 use crate::model::Effect;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
 
 #[test]
 fn recovers_the_true_model_within_three_std() {
