@@ -1062,45 +1062,53 @@ fn choose_minimum(
     let mut hs: Vec<usize> = horizons.iter().map(|h| (*h).max(1)).collect();
     hs.sort_unstable();
     hs.dedup();
-    // one-step errors and k-step errors per horizon, per record
-    let errors = |pt: &Point| -> (Vec<Vec<f64>>, Vec<Vec<Vec<f64>>>) {
+    // prediction errors per record: one step, or per horizon of `hs`
+    let errors_of = |pt: &Point, one: bool| -> Vec<Vec<Vec<f64>>> {
         let m = prob.model(&pt.params);
-        let mut one = Vec::with_capacity(prob.recs.len());
-        let mut multi = vec![Vec::with_capacity(prob.recs.len()); hs.len()];
+        let mut out = vec![Vec::with_capacity(prob.recs.len()); if one { 1 } else { hs.len() }];
         for (r, x) in prob.recs.iter().zip(&pt.x0) {
-            let err = |p: Vec<f64>| -> Vec<f64> { r.y.iter().zip(p).map(|(y, p)| y - p).collect() };
-            one.push(err(predict::one_step(&m, r, x)));
-            for (slot, p) in multi.iter_mut().zip(predict::k_steps(&m, r, x, &hs)) {
-                slot.push(err(p));
+            let preds = if one {
+                vec![predict::one_step(&m, r, x)]
+            } else {
+                predict::k_steps(&m, r, x, &hs)
+            };
+            for (slot, p) in out.iter_mut().zip(preds) {
+                slot.push(r.y.iter().zip(p).map(|(y, p)| y - p).collect());
             }
         }
-        (one, multi)
+        out
     };
-    let all: Vec<_> = pool.iter().map(|(_, s)| errors(&s.pt)).collect();
-    let base = &all[lowest];
-    let base_mse: Vec<f64> = base.1.iter().map(|e| choose::mse(e)).collect();
-    let base_total = prob.total(&pool[lowest].1.pt);
+    let base_pt = &pool[lowest].1.pt;
+    let base_total = prob.total(base_pt);
+    let base_one = errors_of(base_pt, true).remove(0);
+    // the minima as good one step ahead (the cheap test first: k-step errors only for them)
+    let equal: Vec<(usize, f64)> = pool
+        .iter()
+        .enumerate()
+        .filter(|(i, (_, s))| {
+            // a start that ended in the lowest minimum itself (to well within the sampling
+            // spread): its tiny differences may test significant but mean nothing
+            *i != lowest && prob.total(&s.pt) - base_total > 1e-6 * base_total
+        })
+        .filter_map(|(i, (_, s))| {
+            let count = s.pt.count.max(1) as f64;
+            // the penalty's share of the cost difference (0 for plain PEM)
+            let extra = (prob.pen.value(&s.pt.params) - prob.pen.value(&base_pt.params)) / count;
+            let z = choose::dm_z(&errors_of(&s.pt, true)[0], &base_one, extra);
+            // NaN (no usable samples) never qualifies
+            (z < choose::Z_EQUAL).then_some((i, z))
+        })
+        .collect();
+    if equal.is_empty() {
+        return (lowest, None);
+    }
+    let base_multi = errors_of(base_pt, false);
+    let base_mse: Vec<f64> = base_multi.iter().map(|e| choose::mse(e)).collect();
     let mut best: Option<choose::StartChoice> = None;
     let mut pick = lowest;
-    for (i, (one, multi)) in all.iter().enumerate() {
-        if i == lowest {
-            continue;
-        }
+    for (i, z) in equal {
         let pt = &pool[i].1.pt;
-        // a start that ended in the lowest minimum itself (to well within the sampling
-        // spread): its tiny differences may test significant but mean nothing
-        if prob.total(pt) - base_total <= 1e-6 * base_total {
-            continue;
-        }
-        let count = pt.count.max(1) as f64;
-        // the penalty's share of the cost difference (0 for plain PEM)
-        let extra =
-            (prob.pen.value(&pt.params) - prob.pen.value(&pool[lowest].1.pt.params)) / count;
-        let z = choose::dm_z(one, &base.0, extra);
-        // NaN (no usable samples) never qualifies
-        if z.is_nan() || z >= choose::Z_EQUAL {
-            continue;
-        }
+        let multi = errors_of(pt, false);
         let ratio = multi
             .iter()
             .zip(&base_mse)
@@ -1108,7 +1116,7 @@ fn choose_minimum(
             .sum::<f64>()
             / hs.len() as f64;
         let zm = choose::dm_z_of(
-            &choose::scaled_differences(multi, &base.1),
+            &choose::scaled_differences(&multi, &base_multi),
             0.0,
             hs.last().copied().unwrap_or(1),
         );
