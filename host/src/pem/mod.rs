@@ -8,9 +8,12 @@
 //! saturation) stay as given. Each record has its own x̂(0), estimated jointly with θ (the
 //! initial states are eliminated from the normal equations, so they cost nothing extra).
 //!
-//! Starts: ARX least squares and an ARMAX fit by extended least squares, both converted to the
-//! canonical form and stabilised, plus the template when it is a full model; the best end
-//! point wins. Steps that would make A or A − KC unstable are refused.
+//! Starts: ARX least squares, an ARMAX fit by extended least squares and a subspace (N4SID)
+//! estimate, converted to the canonical form and stabilised, plus the template when it is a
+//! full model. Steps that would make A or A − KC unstable are refused. Among the end points
+//! whose predictor forgets its initial state, the lowest cost wins, unless another is as good
+//! one step ahead and significantly better over several steps ([`choose`]); AIC and BIC are
+//! those of the lowest.
 //!
 //! Parameter covariance `P = σ̂² (M + λR)⁻¹ M (M + λR)⁻¹` with `M = JᵀJ` (x̂(0) eliminated),
 //! `σ̂² = Σε²/(N − p)`. The paper's reliability rule is reported: any STD% above 10 makes the
