@@ -85,18 +85,8 @@ pub(crate) fn start_name(s: Start) -> &'static str {
 /// as the regularisation penalty), over its standard error. Samples where either error is
 /// not finite are skipped; see [`dm_z_of`] for the variance.
 pub(crate) fn dm_z(a: &[Vec<f64>], b: &[Vec<f64>], extra: f64) -> f64 {
-    let ds: Vec<Vec<f64>> = a
-        .iter()
-        .zip(b)
-        .map(|(ra, rb)| {
-            ra.iter()
-                .zip(rb)
-                .filter(|(x, y)| x.is_finite() && y.is_finite())
-                .map(|(x, y)| x * x - y * y)
-                .collect()
-        })
-        .collect();
-    dm_z_of(&ds, extra, 0)
+    // z does not depend on the scale of d: the scaled differences serve, `extra` scaled alike
+    dm_z_of(&scaled_differences(&[a], &[b]), extra / mse(b), 0)
 }
 
 /// Diebold–Mariano statistic of the loss differences `ds` (one series per record): their
@@ -148,16 +138,18 @@ pub(crate) fn dm_z_of(ds: &[Vec<f64>], extra: f64, min_bw: usize) -> f64 {
 /// Loss differences of several horizons at once, per record: d(t) = Σ_h (a_h(t)² −
 /// b_h(t)²)/s_h with s_h the pooled mean square of `b_h` (each horizon counts alike), over
 /// the samples where every error is finite. `a[h][r]` is horizon h's error series on record r.
-pub(crate) fn scaled_differences(a: &[Vec<Vec<f64>>], b: &[Vec<Vec<f64>>]) -> Vec<Vec<f64>> {
+pub(crate) fn scaled_differences<E: AsRef<[Vec<f64>]>>(a: &[E], b: &[E]) -> Vec<Vec<f64>> {
+    let a: Vec<&[Vec<f64>]> = a.iter().map(AsRef::as_ref).collect();
+    let b: Vec<&[Vec<f64>]> = b.iter().map(AsRef::as_ref).collect();
     let scale: Vec<f64> = b.iter().map(|e| mse(e)).collect();
-    let recs = b.first().map_or(0, Vec::len);
+    let recs = b.first().map_or(0, |h| h.len());
     (0..recs)
         .map(|r| {
             let len = b[0][r].len();
             (0..len)
                 .filter_map(|t| {
                     let mut d = 0.0;
-                    for ((ah, bh), s) in a.iter().zip(b).zip(&scale) {
+                    for ((ah, bh), s) in a.iter().zip(&b).zip(&scale) {
                         let (x, y) = (ah[r][t], bh[r][t]);
                         if !(x.is_finite() && y.is_finite()) {
                             return None;
