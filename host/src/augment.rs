@@ -39,6 +39,14 @@
 //!    then preferred — neither horizon is significantly worse, and it does not validate
 //!    worse than the input model at 10 steps or in simulation. Otherwise the input model is
 //!    returned unchanged, with the reason.
+//!
+//! # Forward selection
+//!
+//! [`forward`] searches the library for the best predictor: each round tries every effect the
+//! model lacks, exactly as above against one shared baseline, adds the kept one with the best
+//! held-out 10-step fit, and repeats until a round keeps none. It finds what the diagnosis
+//! rightly leaves out — physics the simulator has but a linear model lacks on every record,
+//! above all the hull's own nonlinear damping (`yawcast augment --more`).
 
 use std::collections::BTreeMap;
 
@@ -698,13 +706,43 @@ pub fn augment(
     val: &[Record],
     cfg: &AugmentConfig,
 ) -> Result<AugmentReport, AugmentError> {
+    check_records(model, est, val)?;
+    if model.effect(kind).is_some() {
+        return Err(AugmentError::AlreadyPresent(kind));
+    }
+    let prep = prepare(model, est, val, cfg)?;
+    Ok(try_effect(model, kind, est, &prep, cfg))
+}
+
+/// Checks the model and the records [`augment`] and [`forward`] are given.
+fn check_records(model: &Model, est: &[Record], val: &[Record]) -> Result<(), AugmentError> {
     check_inputs(model, est, 0, "estimation")?;
     if !val.is_empty() {
         check_inputs(model, val, 0, "validation")?;
     }
-    if model.effect(kind).is_some() {
-        return Err(AugmentError::AlreadyPresent(kind));
-    }
+    Ok(())
+}
+
+/// What every candidate effect on one input model is compared with: the held-out split,
+/// the horizons, and the input structure re-identified (the baseline) with both evaluated.
+struct Prepared {
+    est_part: Vec<Record>,
+    val_part: Vec<Record>,
+    held_note: Option<String>,
+    horizons: Vec<Horizon>,
+    base: PemReport,
+    before: Eval,
+    baseline: Eval,
+}
+
+/// Splits the records and identifies and evaluates the baseline (step 1 and the `before`
+/// and `baseline` columns of step 3).
+fn prepare(
+    model: &Model,
+    est: &[Record],
+    val: &[Record],
+    cfg: &AugmentConfig,
+) -> Result<Prepared, AugmentError> {
     let (est_part, val_part, held_note) = if val.is_empty() {
         let (e, v, note) = holdout(est, model.n)?;
         (e, v, Some(note))
@@ -717,15 +755,44 @@ pub fn augment(
             horizons.push(h);
         }
     }
-
     // baseline: the input structure re-identified on the same estimation records
     let base = reidentify_final(&est_part, model, &[], cfg)?;
     let before = evaluate(model, &val_part, &horizons, cfg.parallel);
     let baseline = evaluate(&base.model, &val_part, &horizons, cfg.parallel);
+    Ok(Prepared {
+        est_part,
+        val_part,
+        held_note,
+        horizons,
+        base,
+        before,
+        baseline,
+    })
+}
+
+/// Steps 2–4 for one effect against a prepared baseline.
+fn try_effect(
+    model: &Model,
+    kind: EffectKind,
+    est: &[Record],
+    prep: &Prepared,
+    cfg: &AugmentConfig,
+) -> AugmentReport {
+    let Prepared {
+        est_part,
+        val_part,
+        held_note,
+        horizons,
+        base,
+        before,
+        baseline,
+    } = prep;
+    let (est_part, val_part, horizons) = (&est_part[..], &val_part[..], &horizons[..]);
+    let held_note = held_note.clone();
 
     // candidate
     let (cand, search_note) = if kind.is_actuator() {
-        match choose_actuator(kind, model, &base.model, &est_part, cfg) {
+        match choose_actuator(kind, model, &base.model, est_part, cfg) {
             Some(c) => {
                 let note = format!(
                     "{} grid values scored with θ frozen, {} re-identified, best {}",
@@ -734,7 +801,7 @@ pub fn augment(
                     describe(&Effect::zero(kind, c.value), model.ts)
                 );
                 // the chosen value's structure identified as the baseline was
-                let fin = reidentify_final(&est_part, &c.rep.model, &[], cfg).unwrap_or(c.rep);
+                let fin = reidentify_final(est_part, &c.rep.model, &[], cfg).unwrap_or(c.rep);
                 (Some(fin), note)
             }
             None => (None, "no usable grid value".to_string()),
@@ -745,24 +812,24 @@ pub fn augment(
         // baseline's minimum or a lower one on the estimation records
         let nested = base.model.clone().with_effect(Effect::zero(kind, 0.0));
         (
-            reidentify_final(&est_part, &t, &[nested], cfg).ok(),
+            reidentify_final(est_part, &t, &[nested], cfg).ok(),
             String::new(),
         )
     };
     let Some(cand) = cand else {
         let candidate = model.clone().with_effect(Effect::zero(kind, 1.0));
-        return Ok(failed_report(
+        return failed_report(
             kind,
             model,
             candidate,
-            &before,
-            &baseline,
-            &horizons,
+            before,
+            baseline,
+            horizons,
             held_note,
             "the augmented model could not be identified (every start failed or went unstable)",
-        ));
+        );
     };
-    let after = evaluate(&cand.model, &val_part, &horizons, cfg.parallel);
+    let after = evaluate(&cand.model, val_part, horizons, cfg.parallel);
 
     let extra = if kind.is_actuator() { 1.0 } else { 0.0 };
     let nf = cand.samples as f64;
@@ -811,7 +878,7 @@ pub fn augment(
         reasons.push("it predicts significantly worse at 10 steps or in simulation".into());
     }
     for k in ["10", "sim"] {
-        if get(&after, k) < get(&before, k) {
+        if get(&after, k) < get(before, k) {
             reasons.push(format!(
                 "it would validate worse than the input model at {} ({:.1} < {:.1} %)",
                 if k == "sim" {
@@ -820,7 +887,7 @@ pub fn augment(
                     format!("{k} steps")
                 },
                 get(&after, k),
-                get(&before, k)
+                get(before, k)
             ));
         }
     }
@@ -849,10 +916,10 @@ pub fn augment(
         "{}; 10-step fit {:.1} → {:.1} % on held-out records (the model re-identified without it: {:.1} %), \
          simulation fit {:.1} → {:.1} %; ΔBIC {:+.1}",
         describe(&eff, model.ts),
-        get(&before, "10"),
+        get(before, "10"),
         get(&after, "10"),
-        get(&baseline, "10"),
-        get(&before, "sim"),
+        get(baseline, "10"),
+        get(before, "sim"),
         get(&after, "sim"),
         delta_bic
     );
@@ -894,7 +961,7 @@ pub fn augment(
             .map(|k| (k.clone(), get(e, k)))
             .collect()
     };
-    Ok(AugmentReport {
+    AugmentReport {
         effect: kind,
         model: if kept {
             cand_model.clone()
@@ -903,17 +970,243 @@ pub fn augment(
         },
         candidate: cand_model,
         kept,
-        before: pick(&before),
-        baseline: pick(&baseline),
+        before: pick(before),
+        baseline: pick(baseline),
         after: pick(&after),
-        fit_gain_pp: get(&after, "10") - get(&baseline, "10"),
+        fit_gain_pp: get(&after, "10") - get(baseline, "10"),
         delta_aic,
         delta_bic,
         ljung_box_p_before: ljung_box_p(&before.resid),
         ljung_box_p_after: ljung_box_p(&after.resid),
         std_pct,
         explanation: text,
+    }
+}
+
+/// One effect tried in a round of [`forward`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Tried {
+    /// The effect (serialised as its name).
+    #[serde(serialize_with = "ser_kind")]
+    pub effect: EffectKind,
+    /// Whether [`augment`]'s rule would keep it on the round's model.
+    pub kept: bool,
+    /// Held-out 10-step fit % of the model with it (NaN when it could not be identified).
+    pub fit_10: f64,
+    /// Its held-out gain at 10 steps over the round's model re-identified (pp).
+    pub fit_gain_pp: f64,
+    /// ΔBIC against the round's model re-identified.
+    pub delta_bic: f64,
+}
+
+/// One round of [`forward`]: every library effect the model lacks, tried on it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Round {
+    /// Every effect tried, in library order.
+    pub tried: Vec<Tried>,
+    /// The report of the effect added in this round (of those kept, the one with the best
+    /// held-out 10-step fit); `None` in the last round, where none was kept.
+    pub added: Option<AugmentReport>,
+}
+
+/// What [`forward`] found.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ForwardReport {
+    /// The input model with every added effect, re-identified.
+    pub model: Model,
+    /// The effects added, in order (serialised as names).
+    #[serde(serialize_with = "ser_kinds")]
+    pub added: Vec<EffectKind>,
+    /// The rounds, the last one adding nothing (unless the candidates ran out).
+    pub rounds: Vec<Round>,
+    /// Held-out fit % of the input model, keyed by horizon.
+    pub before: BTreeMap<String, f64>,
+    /// Held-out fit % of the returned model (before its final refit on whole records).
+    pub after: BTreeMap<String, f64>,
+    /// Physical words with numbers: what was added, what each bought, what was not and why.
+    pub explanation: String,
+}
+
+fn ser_kinds<S: Serializer>(k: &[EffectKind], s: S) -> Result<S::Ok, S::Error> {
+    s.collect_seq(k.iter().map(|k| k.name()))
+}
+
+/// Forward selection over the effects library: tries every effect of `candidates` the model
+/// lacks, each as [`augment`] would (same estimation and held-out records, same decision
+/// rule, one shared baseline per round), adds the kept one with the best held-out 10-step
+/// fit, and repeats on the augmented model until no effect is kept or none is left.
+///
+/// This is for the predictor, not for the diagnosis: a linear model of a nonlinear hull
+/// lacks the hull's own nonlinear damping on *any* record, including the simulator's, so
+/// [`crate::diagnose`] (which looks for what the trials have and the reference lacks) rightly
+/// does not name it — yet adding it can buy several points of k-step fit.
+///
+/// # Errors
+/// As [`augment`]: [`AugmentError::Input`] for unusable model or records, and
+/// [`AugmentError::Ident`] when a round's input structure cannot be re-identified. A
+/// candidate that fails is reported as not kept.
+///
+/// ```
+/// use yawcast::{augment::{forward, AugmentConfig}, data::Record, model::{Effect, Model}, predict};
+/// use yawcast_shared::model::EffectKind;
+/// // a 2nd-order ship whose commands arrive two samples late
+/// let truth = Model::new(1.0, vec![-0.3, 0.9], vec![0.5, 0.4], vec![0.0, 0.0]).unwrap();
+/// let delayed = truth.clone().with_effect(Effect::DeadTime { samples: 2 });
+/// let rec = |seed: usize| {
+///     let u: Vec<f64> = (0..400).map(|i| if ((i + seed) * 37 / 11) % 2 == 0 { 1.0 } else { -1.0 }).collect();
+///     let mut r = Record::from_uy("r", 1.0, u, vec![0.0; 400]);
+///     r.y = predict::simulate(&delayed, &r, &[0.0, 0.0]).iter().enumerate()
+///         .map(|(i, v)| v + 0.01 * ((i * 7919 + seed) % 13) as f64).collect();
+///     r
+/// };
+/// let cands = [EffectKind::DeadTime, EffectKind::RateLimit, EffectKind::Bias];
+/// let rep = forward(&truth, &[rec(1), rec(2)], &[rec(3), rec(4)], &cands,
+///                   &AugmentConfig::default()).unwrap();
+/// assert_eq!(rep.added[0], EffectKind::DeadTime);
+/// assert_eq!(rep.model.effect(EffectKind::DeadTime), Some(&Effect::DeadTime { samples: 2 }));
+/// assert!(rep.after["10"] > rep.before["10"]);
+/// ```
+pub fn forward(
+    model: &Model,
+    est: &[Record],
+    val: &[Record],
+    candidates: &[EffectKind],
+    cfg: &AugmentConfig,
+) -> Result<ForwardReport, AugmentError> {
+    check_records(model, est, val)?;
+    let mut current = model.clone();
+    let mut rounds: Vec<Round> = Vec::new();
+    let mut added: Vec<EffectKind> = Vec::new();
+    let mut before: Option<BTreeMap<String, f64>> = None;
+    let mut held_note = None;
+    loop {
+        let todo: Vec<EffectKind> = candidates
+            .iter()
+            .copied()
+            .filter(|k| current.effect(*k).is_none())
+            .fold(Vec::new(), |mut v, k| {
+                if !v.contains(&k) {
+                    v.push(k);
+                }
+                v
+            });
+        if todo.is_empty() {
+            break;
+        }
+        let prep = prepare(&current, est, val, cfg)?;
+        held_note.clone_from(&prep.held_note);
+        let reports = crate::par::map(&todo, cfg.parallel, |k| {
+            try_effect(&current, *k, est, &prep, cfg)
+        });
+        if before.is_none() {
+            before = reports.first().map(|r| r.before.clone());
+        }
+        let tried = reports
+            .iter()
+            .map(|r| Tried {
+                effect: r.effect,
+                kept: r.kept,
+                fit_10: r.after.get("10").copied().unwrap_or(f64::NAN),
+                fit_gain_pp: r.fit_gain_pp,
+                delta_bic: r.delta_bic,
+            })
+            .collect();
+        let best = reports
+            .into_iter()
+            .filter(|r| r.kept)
+            .fold(None::<AugmentReport>, |b, r| {
+                let f10 = |a: &AugmentReport| a.after.get("10").copied().unwrap_or(f64::NAN);
+                match b {
+                    Some(b) if f10(&b) >= f10(&r) => Some(b),
+                    _ => Some(r),
+                }
+            });
+        let done = best.is_none();
+        if let Some(b) = &best {
+            current = b.model.clone();
+            added.push(b.effect);
+        }
+        rounds.push(Round { tried, added: best });
+        if done {
+            break;
+        }
+    }
+    let before = before.unwrap_or_default();
+    let after = rounds
+        .iter()
+        .rev()
+        .find_map(|r| r.added.as_ref().map(|a| a.after.clone()))
+        .unwrap_or_else(|| before.clone());
+    let explanation = forward_explanation(&current, &added, &rounds, &before, &after, held_note);
+    Ok(ForwardReport {
+        model: current,
+        added,
+        rounds,
+        before,
+        after,
+        explanation,
     })
+}
+
+fn forward_explanation(
+    model: &Model,
+    added: &[EffectKind],
+    rounds: &[Round],
+    before: &BTreeMap<String, f64>,
+    after: &BTreeMap<String, f64>,
+    held_note: Option<String>,
+) -> String {
+    let get = |m: &BTreeMap<String, f64>, k: &str| m.get(k).copied().unwrap_or(f64::NAN);
+    let mut text = if added.is_empty() {
+        "no further effect pays for itself on the held-out records; the model is kept as it is"
+            .to_string()
+    } else {
+        let steps: Vec<String> = rounds
+            .iter()
+            .filter_map(|r| r.added.as_ref())
+            .map(|a| {
+                let eff = model
+                    .effect(a.effect)
+                    .copied()
+                    .unwrap_or(Effect::zero(a.effect, 0.0));
+                format!(
+                    "{} ({}), {:+.2} pp at 10 steps over the model re-identified without it",
+                    a.effect.name(),
+                    describe(&eff, model.ts),
+                    a.fit_gain_pp
+                )
+            })
+            .collect();
+        format!(
+            "added, one at a time while the held-out records paid for each: {}; 10-step fit \
+             {:.1} → {:.1} %, simulation fit {:.1} → {:.1} %",
+            steps.join(", then "),
+            get(before, "10"),
+            get(after, "10"),
+            get(before, "sim"),
+            get(after, "sim")
+        )
+    };
+    if let Some(last) = rounds.last().filter(|r| r.added.is_none()) {
+        let best = last
+            .tried
+            .iter()
+            .filter(|t| t.fit_gain_pp.is_finite())
+            .max_by(|a, b| a.fit_gain_pp.total_cmp(&b.fit_gain_pp));
+        if let Some(t) = best {
+            text.push_str(&format!(
+                ". Of the rest none was kept (the closest: {}, {:+.2} pp at 10 steps, ΔBIC {:+.1})",
+                t.effect.name(),
+                t.fit_gain_pp,
+                t.delta_bic
+            ));
+        }
+    }
+    if let Some(n) = held_note {
+        text.push_str(&format!(". Note: {n}"));
+    }
+    text.push('.');
+    text
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -1534,6 +1827,80 @@ mod tests {
             assert_eq!(&r.model, base());
             assert!(r.explanation.contains("Not kept"), "{}", r.explanation);
         }
+    }
+
+    #[test]
+    fn forward_selection_adds_the_hulls_own_damping_after_the_diagnosed_effect() {
+        // trials with a hidden asymmetry: augmenting with it leaves the hull's own nonlinear
+        // damping (which the clean simulator records need as much) for the search to add
+        let ship = Ship::default_lng();
+        let e = SimEffect::hidden(EffectKind::Asymmetry, 1.0);
+        let est = recs(&ship, Some(e), &EST);
+        let val = recs(&ship, Some(e), &VAL);
+        let cfg = AugmentConfig::default();
+        let first = augment(base(), EffectKind::Asymmetry, &est, &val, &cfg).unwrap();
+        assert!(first.kept, "{}", first.explanation);
+        let f = forward(&first.model, &est, &val, &EffectKind::ALL, &cfg).unwrap();
+        assert_eq!(
+            f.added.first(),
+            Some(&EffectKind::NonlinearDamping),
+            "{}",
+            f.explanation
+        );
+        assert!(f.model.effect(EffectKind::Asymmetry).is_some());
+        let Some(Effect::NonlinearDamping { beta, .. }) =
+            f.model.effect(EffectKind::NonlinearDamping)
+        else {
+            panic!("no damping")
+        };
+        assert!(*beta < 0.0, "{beta}");
+        // the search started from the augmented model and bought several points more
+        assert_eq!(f.before, first.after);
+        assert!(f.after["10"] > f.before["10"] + 3.0, "{}", f.explanation);
+        assert!(f.after["sim"] > f.before["sim"] + 3.0, "{}", f.explanation);
+        // one round per added effect and a last one that adds nothing; every round tries
+        // exactly the effects the model lacked
+        assert_eq!(f.rounds.len(), f.added.len() + 1);
+        assert!(f.rounds.last().unwrap().added.is_none());
+        assert_eq!(f.rounds[0].tried.len(), EffectKind::ALL.len() - 1);
+        for (i, r) in f.rounds.iter().enumerate() {
+            assert_eq!(r.tried.len(), EffectKind::ALL.len() - 1 - i);
+            assert!(r.tried.iter().all(|t| t.effect != EffectKind::Asymmetry));
+        }
+        assert_eq!(f.model.effects.len(), 1 + f.added.len());
+        assert!(round_trips(&f.model));
+        assert!(
+            f.explanation.contains("nonlinear-damping"),
+            "{}",
+            f.explanation
+        );
+    }
+
+    #[test]
+    fn forward_selection_adds_nothing_to_a_linear_ship() {
+        // records of a linear innovations model: no library effect pays for itself
+        use crate::pem::testdata::{record, truth};
+        let truth = truth();
+        let est = [record(1, 1500), record(2, 1500)];
+        let val = [record(3, 1500), record(4, 1500)];
+        let f = forward(
+            &truth,
+            &est,
+            &val,
+            &EffectKind::ALL,
+            &AugmentConfig::default(),
+        )
+        .unwrap();
+        assert!(f.added.is_empty(), "{}", f.explanation);
+        assert_eq!(f.model, truth);
+        assert_eq!(f.rounds.len(), 1);
+        assert_eq!(f.rounds[0].tried.len(), EffectKind::ALL.len());
+        assert_eq!(f.after, f.before);
+        assert!(
+            f.explanation.starts_with("no further effect"),
+            "{}",
+            f.explanation
+        );
     }
 
     #[test]
