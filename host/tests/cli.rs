@@ -915,6 +915,8 @@ fn augment_adds_a_dead_time_exports_it_and_writes_the_ship() {
     assert!(v["delta_bic"].as_f64().unwrap() < 0.0);
     assert!(v["explanation"].as_str().unwrap().contains("Kept"));
     assert_eq!(v["ship"], s(&ship));
+    assert!(v["more"].is_null(), "{}", v["more"]);
+    assert_eq!(v["effects"], serde_json::json!(["dead-time"]));
     // the blob decodes to the model with the dead time; the twin sits beside it
     let blob = std::fs::read(&out).unwrap();
     let spec = yawcast_shared::blob::decode_blob(&blob).unwrap();
@@ -965,6 +967,100 @@ fn augment_adds_a_dead_time_exports_it_and_writes_the_ship() {
     );
     assert!(stderr(&o).contains("nonlinear-damping"), "{}", stderr(&o));
     assert!(!d.join("x.postcard").exists());
+}
+
+#[test]
+fn augment_more_searches_the_library_and_pins_its_json() {
+    use yawcast::sim::SimEffect;
+    use yawcast_shared::model::EffectKind;
+    let d = scratch("augment-more");
+    let reference = sim_csvs(&d, "ref", None, &[311, 312]);
+    let recs: Vec<_> = reference
+        .iter()
+        .map(|p| yawcast::data::read_csv(p).unwrap())
+        .collect();
+    let base = yawcast::pem::identify(&recs, None, &Default::default())
+        .unwrap()
+        .model;
+    let model = d.join("base.json");
+    std::fs::write(&model, serde_json::to_string(&base).unwrap()).unwrap();
+    let hidden = SimEffect::hidden(EffectKind::Asymmetry, 1.0);
+    let est = sim_csvs(&d, "trial", Some(hidden), &[21, 22]);
+    let val = sim_csvs(&d, "check", Some(hidden), &[31, 32]);
+    let s = |p: &Path| p.display().to_string();
+    let augment = |effect: &str, more: bool, out: &Path, json: &Path| {
+        let mut c = bin();
+        c.args(["augment", "--model", &s(&model), "--effect", effect]);
+        for p in &est {
+            c.arg("--data").arg(p);
+        }
+        for p in &val {
+            c.arg("--validate").arg(p);
+        }
+        if more {
+            c.arg("--more");
+        }
+        c.arg("--out").arg(out).arg("--json").arg(json);
+        c.output().unwrap()
+    };
+    let (out, json) = (d.join("aug.postcard"), d.join("aug-summary.json"));
+    let o = augment("asymmetry", true, &out, &json);
+    assert_eq!(code(&o), 0, "{}\n{}", stdout(&o), stderr(&o));
+    assert!(stdout(&o).contains("--more: "), "{}", stdout(&o));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    // the named effect's fields as without --more
+    assert_eq!(v["effect"], "asymmetry");
+    assert_eq!(v["kept"], true);
+    // the search: the hull's own damping first, from the asymmetry model's held-out fit
+    let more = &v["more"];
+    assert_eq!(more["added"][0], "nonlinear-damping", "{more}");
+    assert_eq!(more["before"]["fit"]["10"], v["after"]["fit"]["10"]);
+    let (b10, a10) = (
+        more["before"]["fit"]["10"].as_f64().unwrap(),
+        more["after"]["fit"]["10"].as_f64().unwrap(),
+    );
+    assert!(a10 > b10 + 3.0, "{b10} → {a10}");
+    let rounds = more["rounds"].as_array().unwrap();
+    assert_eq!(rounds.len(), more["added"].as_array().unwrap().len() + 1);
+    assert_eq!(rounds[0]["added"], "nonlinear-damping");
+    assert!(rounds.last().unwrap()["added"].is_null());
+    let tried = rounds[0]["tried"].as_array().unwrap();
+    assert_eq!(tried.len(), EffectKind::ALL.len() - 1);
+    for t in tried {
+        for k in ["effect", "kept", "fit_10", "fit_gain_pp", "delta_bic"] {
+            assert!(!t[k].is_null(), "{k}: {t}");
+        }
+    }
+    assert!(more["explanation"]
+        .as_str()
+        .unwrap()
+        .contains("one at a time"));
+    // the model written carries every effect, in the blob and in `effects`
+    let blob = std::fs::read(&out).unwrap();
+    let m = yawcast::model::Model::from_spec(&yawcast_shared::blob::decode_blob(&blob).unwrap())
+        .unwrap();
+    let names: Vec<&str> = m.effects.iter().map(|e| e.kind().name()).collect();
+    assert_eq!(v["effects"], serde_json::json!(names));
+    assert!(
+        names.starts_with(&["asymmetry", "nonlinear-damping"]),
+        "{names:?}"
+    );
+
+    // `--effect none` is only the search, and needs --more
+    let (out2, json2) = (d.join("none.postcard"), d.join("none-summary.json"));
+    let o = augment("none", false, &out2, &json2);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("give --more"), "{}", stderr(&o));
+    assert!(!out2.exists());
+    let o = augment("none", true, &out2, &json2);
+    assert_eq!(code(&o), 0, "{}\n{}", stdout(&o), stderr(&o));
+    let w: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json2).unwrap()).unwrap();
+    assert_eq!(w["effect"], "none");
+    assert_eq!(w["auto"], false);
+    assert!(!w["more"]["added"].as_array().unwrap().is_empty(), "{w}");
+    assert_eq!(w["effects"], w["more"]["added"]);
 }
 
 #[test]

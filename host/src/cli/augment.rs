@@ -23,9 +23,16 @@ pub struct AugmentArgs {
     #[arg(long, value_name = "FILE")]
     pub model: PathBuf,
     /// The effect to add (bias, gyro-bias, dead-time, rate-limit, saturation, asymmetry,
-    /// nonlinear-damping, wind, current), or `auto` for the verdict of `yawcast diagnose`.
+    /// nonlinear-damping, wind, current), `auto` for the verdict of `yawcast diagnose`, or
+    /// `none` (with `--more`: only the search).
     #[arg(long, value_name = "NAME")]
     pub effect: String,
+    /// Then search the effects library: add further effects one at a time, each only while
+    /// the held-out records pay for it (the same rule as for the named effect), for the best
+    /// predictor — e.g. the hull's own nonlinear damping, which the simulator's records need
+    /// as much as the trials, so `diagnose` does not name it.
+    #[arg(long)]
+    pub more: bool,
     /// Estimation records (CSV or NMEA); repeatable.
     #[arg(long, value_name = "FILE", required = true)]
     pub data: Vec<PathBuf>,
@@ -91,19 +98,97 @@ pub struct AugmentSummary {
     pub ship: Option<PathBuf>,
     /// The effect written into the ship file (physical units), or null.
     pub sim_effect: Option<SimEffect>,
+    /// The search of `--more`, or null without it.
+    pub more: Option<MoreSummary>,
+    /// The effects of the model written, in the order they act.
+    pub effects: Vec<String>,
 }
 
-fn parse_effect(name: &str) -> Result<Option<EffectKind>> {
-    if name == "auto" {
-        return Ok(None);
+/// The `more` object of the JSON summary: the search of `--more`.
+#[derive(Debug, Serialize)]
+pub struct MoreSummary {
+    /// The effects added, in order.
+    pub added: Vec<String>,
+    /// Held-out fits of the model the search started from.
+    pub before: FitSummary,
+    /// Held-out fits of the model written.
+    pub after: FitSummary,
+    /// Every round: each effect tried with its held-out 10-step fit and gain, and the one added.
+    pub rounds: Vec<RoundSummary>,
+    /// Physical words with numbers.
+    pub explanation: String,
+}
+
+/// One round of the `--more` search in the JSON summary.
+#[derive(Debug, Serialize)]
+pub struct RoundSummary {
+    /// The effect added in this round, or null (the last round).
+    pub added: Option<String>,
+    /// Every effect tried.
+    pub tried: Vec<augment::Tried>,
+}
+
+impl MoreSummary {
+    fn of(f: &augment::ForwardReport) -> Self {
+        MoreSummary {
+            added: f.added.iter().map(|k| k.name().to_string()).collect(),
+            before: FitSummary {
+                fit: f.before.clone(),
+            },
+            after: FitSummary {
+                fit: f.after.clone(),
+            },
+            rounds: f
+                .rounds
+                .iter()
+                .map(|r| RoundSummary {
+                    added: r.added.as_ref().map(|a| a.effect.name().to_string()),
+                    tried: r.tried.clone(),
+                })
+                .collect(),
+            explanation: f.explanation.clone(),
+        }
     }
-    EffectKind::from_name(name).map(Some).ok_or_else(|| {
-        let names: Vec<&str> = EffectKind::ALL.iter().map(|k| k.name()).collect();
-        bad(format!(
-            "--effect: unknown effect `{name}`; valid names: {}, auto",
-            names.join(", ")
-        ))
-    })
+}
+
+fn effect_names(m: &Model) -> Vec<String> {
+    m.effects
+        .iter()
+        .map(|e| e.kind().name().to_string())
+        .collect()
+}
+
+/// What `--effect` asks for.
+enum Wanted {
+    /// One library effect.
+    Named(EffectKind),
+    /// The verdict of `diagnose`.
+    Auto,
+    /// No named effect (only the `--more` search).
+    Nothing,
+}
+
+fn parse_effect(name: &str, more: bool) -> Result<Wanted> {
+    match name {
+        "auto" => return Ok(Wanted::Auto),
+        "none" if more => return Ok(Wanted::Nothing),
+        "none" => {
+            return Err(bad(
+                "--effect none adds nothing: give --more to search the effects library, \
+                 or name an effect",
+            ))
+        }
+        _ => {}
+    }
+    EffectKind::from_name(name)
+        .map(Wanted::Named)
+        .ok_or_else(|| {
+            let names: Vec<&str> = EffectKind::ALL.iter().map(|k| k.name()).collect();
+            bad(format!(
+                "--effect: unknown effect `{name}`; valid names: {}, auto, none (with --more)",
+                names.join(", ")
+            ))
+        })
 }
 
 fn read_checked(read: &ReadArgs, paths: &[PathBuf], model: &Model) -> Result<Vec<Record>> {
@@ -130,7 +215,7 @@ fn cli_err(e: AugmentError) -> anyhow::Error {
 
 /// Runs `yawcast augment`.
 pub fn run(args: &AugmentArgs) -> Result<()> {
-    let kind = parse_effect(&args.effect)?;
+    let wanted = parse_effect(&args.effect, args.more)?;
     let (_, twin) = export::paths(&args.out);
     if args.json.json.as_ref() == Some(&twin) {
         return Err(bad(format!(
@@ -143,29 +228,32 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
     let val = read_checked(&args.read, &args.validate, &model)?;
     let reference = read_checked(&args.read, &args.reference, &model)?;
     let seed = args.seed.resolve();
-    let (kind, auto) = match kind {
-        Some(k) => (k, false),
-        None => match choose_auto(&model, &reference, &est, &val, seed)? {
-            Some(k) => (k, true),
-            None => return write_unchanged(args, &model, &est, &val),
-        },
+    let (kind, auto) = match wanted {
+        Wanted::Named(k) => (Some(k), false),
+        Wanted::Nothing => (None, false),
+        Wanted::Auto => (choose_auto(&model, &reference, &est, &val, seed)?, true),
     };
     let cfg = AugmentConfig::default();
+    let Some(kind) = kind else {
+        return write_unchanged(args, &model, &est, &val, auto, &cfg);
+    };
     let t0 = std::time::Instant::now();
     let rep = augment::augment(&model, kind, &est, &val, &cfg).map_err(cli_err)?;
     print_report(&rep, t0.elapsed().as_secs_f64());
+    let more = search_more(args, &rep.model, &est, &val, &cfg)?;
+    let written = more.as_ref().map_or(&rep.model, |f| &f.model);
 
     let check = val
         .first()
         .or(est.first())
         .context("no record to check the export on")?;
-    let ex = export::export(&rep.model, &args.out, check)
+    let ex = export::export(written, &args.out, check)
         .with_context(|| format!("writing the model {}", args.out.display()))?;
     println!(
         "model written to {} and {}{}",
         ex.blob_path.display(),
         ex.json_path.display(),
-        if rep.kept {
+        if rep.kept || more.as_ref().is_some_and(|f| !f.added.is_empty()) {
             ""
         } else {
             " (the input model, unchanged)"
@@ -218,42 +306,110 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
         out: ex.blob_path,
         ship: ship_written,
         sim_effect,
+        more: more.as_ref().map(MoreSummary::of),
+        effects: effect_names(written),
     })
 }
 
-/// `--effect auto` with the verdict `none`: the input model is written unchanged.
+/// The `--more` search from `model` (`None` without `--more`), printed.
+fn search_more(
+    args: &AugmentArgs,
+    model: &Model,
+    est: &[Record],
+    val: &[Record],
+    cfg: &AugmentConfig,
+) -> Result<Option<augment::ForwardReport>> {
+    if !args.more {
+        return Ok(None);
+    }
+    let t0 = std::time::Instant::now();
+    let f = augment::forward(model, est, val, &EffectKind::ALL, cfg).map_err(cli_err)?;
+    println!(
+        "--more: {} round{} over the effects library ({:.1} s)",
+        f.rounds.len(),
+        if f.rounds.len() == 1 { "" } else { "s" },
+        t0.elapsed().as_secs_f64()
+    );
+    for (i, r) in f.rounds.iter().enumerate() {
+        let tried: Vec<String> = r
+            .tried
+            .iter()
+            .map(|t| {
+                format!(
+                    "{} {:+.2}{}",
+                    t.effect.name(),
+                    t.fit_gain_pp,
+                    if t.kept { "*" } else { "" }
+                )
+            })
+            .collect();
+        println!(
+            "  round {}: {} (pp at 10 steps; * kept) → {}",
+            i + 1,
+            tried.join(", "),
+            r.added.as_ref().map_or("none added", |a| a.effect.name())
+        );
+    }
+    println!("{}", f.explanation);
+    Ok(Some(f))
+}
+
+/// No named effect (`--effect auto` with the verdict `none`, or `--effect none`): the input
+/// model, or with `--more` the result of the search from it, is written.
 fn write_unchanged(
     args: &AugmentArgs,
     model: &Model,
     est: &[Record],
     val: &[Record],
+    auto: bool,
+    cfg: &AugmentConfig,
 ) -> Result<()> {
+    let more = search_more(args, model, est, val, cfg)?;
+    let written = more.as_ref().map_or(model, |f| &f.model);
     let check = val
         .first()
         .or(est.first())
         .context("no record to check the export on")?;
-    let ex = export::export(model, &args.out, check)
+    let ex = export::export(written, &args.out, check)
         .with_context(|| format!("writing the model {}", args.out.display()))?;
-    println!(
-        "no effect to add: the input model is written unchanged to {}",
-        ex.blob_path.display()
-    );
-    if let Some(p) = &args.ship {
-        println!("ship file {} left unchanged", p.display());
+    if more.as_ref().is_some_and(|f| !f.added.is_empty()) {
+        println!(
+            "model written to {} and {}",
+            ex.blob_path.display(),
+            ex.json_path.display()
+        );
+    } else {
+        println!(
+            "no effect to add: the input model is written unchanged to {}",
+            ex.blob_path.display()
+        );
     }
+    if let Some(p) = &args.ship {
+        println!(
+            "ship file {} left unchanged (it only takes a named effect)",
+            p.display()
+        );
+    }
+    let explanation = if auto {
+        "diagnose found no missing effect; the model is kept as it is"
+    } else {
+        "no effect named"
+    };
     args.json.write(&serde_json::json!({
         "command": "augment",
         "effect": "none",
-        "auto": true,
+        "auto": auto,
         "kept": false,
         "before": serde_json::Value::Null,
         "after": serde_json::Value::Null,
         "fit_gain_pp": 0.0,
         "delta_aic": serde_json::Value::Null,
         "delta_bic": serde_json::Value::Null,
-        "explanation": "diagnose found no missing effect; the model is kept as it is",
+        "explanation": explanation,
         "out": ex.blob_path,
         "ship": serde_json::Value::Null,
+        "more": more.as_ref().map(MoreSummary::of),
+        "effects": effect_names(written),
     }))
 }
 
