@@ -40,7 +40,8 @@ pub fn with_effects(effects: &[Effect]) -> ModelSpec {
     .expect("reference model validates")
 }
 
-/// The ten reference models: the base model and the base model with each effect.
+/// The eleven reference models: the base model, the base model with each effect, and the
+/// base model with every effect stacked (as `yawcast augment --more` builds them).
 pub fn reference_models() -> Vec<(&'static str, ModelSpec)> {
     vec![
         ("base", base_model()),
@@ -84,6 +85,31 @@ pub fn reference_models() -> Vec<(&'static str, ModelSpec)> {
                 beta_s: 0.5,
                 beta_c: -0.3,
             }]),
+        ),
+        (
+            "stack",
+            with_effects(&[
+                Effect::Asymmetry { beta: 0.2 },
+                Effect::NonlinearDamping {
+                    beta: -0.04,
+                    cubic: false,
+                },
+                Effect::RateLimit { rate: 5.0 },
+                Effect::DeadTime { samples: 2 },
+                Effect::Saturation { limit: 7.0 },
+                Effect::Bias { beta: 0.35 },
+                Effect::GyroBias { d_y: 0.12 },
+                Effect::Wind {
+                    beta_s2: 0.6,
+                    beta_c2: -0.4,
+                    beta_s1: 0.3,
+                    beta_c1: 0.5,
+                },
+                Effect::Current {
+                    beta_s: 0.5,
+                    beta_c: -0.3,
+                },
+            ]),
         ),
     ]
 }
