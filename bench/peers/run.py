@@ -1073,8 +1073,8 @@ class Yawcast:
 
     def augment(self, model, data, effect, out, seed):
         j = Path(out).with_suffix(".run.json")
-        wall = self._run("augment", "--model", model, "--data", data, "--effect", effect, "--out", out, "--json", j,
-                         "--seed", seed)
+        wall = self._run("augment", "--model", model, "--data", data, "--effect", effect, "--more", "--out", out,
+                         "--json", j, "--seed", seed)
         t, doc = self._time(j)
         return wall, t, doc
 
@@ -1182,7 +1182,8 @@ def run_case_yawcast(yc, case, mdir, rows, args, log_print):
         rows.append(frow)
     # the documented workflow: the model of the simulator's (reference) record, diagnosed on
     # the trial against that reference, then augmented (re-identified with the effect) on the
-    # trial; plain PEM on the raw trial record when there is no verdict or augment declines
+    # trial, and `--more` searches the library for further effects the held-out part of the
+    # trial pays for; plain PEM on the raw trial record when the model written has no effect
     raw = mdir / "yawcast-pem-raw.postcard"
     refm = mdir / "yawcast-ref.postcard"
     try:
@@ -1202,21 +1203,21 @@ def run_case_yawcast(yc, case, mdir, rows, args, log_print):
         except Exception as e:  # noqa: BLE001
             row.update(error=str(e))
         rows.append(row)
-    # diagnose against the clean simulator's record, then augment with the verdict
+    # diagnose against the clean simulator's record, then augment with the verdict (and more)
     if not args.no_aug and pem_ok:
         row = {"case": case.name, "effect": case.effect, "seed": case.seed, "tool": "yawcast-aug"}
         try:
             dj = mdir / "diagnose.json"
             wall_d, ddoc = yc.diagnose(refm, case.est, case.ref, dj, seed)
             verdict = _find(ddoc, "verdict", "effect", "best", "missing")
-            if isinstance(verdict, str) and verdict in EFFECTS:
-                aug = mdir / "yawcast-aug.postcard"
-                wall_a, t_a, adoc = yc.augment(refm, case.est, verdict, aug, seed)
-                kept = adoc.get("kept", True) if isinstance(adoc, dict) else True
-                row.update(model=str(yc.twin(aug if kept else raw)), kept=bool(kept))
-            else:
-                wall_a, t_a = 0.0, None
-                row.update(model=str(yc.twin(raw)))
+            named = verdict if isinstance(verdict, str) and verdict in EFFECTS else "none"
+            aug = mdir / "yawcast-aug.postcard"
+            wall_a, t_a, adoc = yc.augment(refm, case.est, named, aug, seed)
+            adoc = adoc if isinstance(adoc, dict) else {}
+            kept = bool(adoc.get("kept", False))
+            effects = adoc.get("effects") or []
+            # the model written carries no effect: the row is plain PEM on the raw trial
+            row.update(model=str(yc.twin(aug if effects else raw)), kept=kept, effects=effects)
             row.update(verdict=verdict if isinstance(verdict, str) else "none", wall_s=wall_d + wall_a,
                        inproc_s=t_a)
         except Exception as e:  # noqa: BLE001
@@ -1544,6 +1545,8 @@ def render(rows, tools, peers, cases, meta, args):
                     bp = max(by[p][c.name]["fits"][h] for p in peers if c.name in by.get(p, {}))
                     gains[h] = (aug["fits"][h] if aug and "fits" in aug else -math.inf) - bp
                 verdict = aug.get("verdict", "?") if aug else "– (plain PEM failed)"
+                if aug and aug.get("effects"):
+                    verdict += " (model: " + " + ".join(aug["effects"]) + ")"
                 hits.append((c.name, cost, verdict, gains))
             ok2 = bool(hits) and all(g["10"] >= 2.0 and g["20"] >= 2.0 for _, _, _, g in hits)
             npass = sum(1 for _, _, _, g in hits if g["10"] >= 2.0 and g["20"] >= 2.0)
@@ -1552,7 +1555,7 @@ def render(rows, tools, peers, cases, meta, args):
                      f"seed − on the effect case): **{'PASS' if ok2 else 'FAIL'}** ({npass}/{len(hits)} records)")
             T.append("")
             if hits:
-                T.append("| record | effect cost (pp) | diagnosed | margin k=10 | margin k=20 | |")
+                T.append("| record | effect cost (pp) | diagnosed (effects of the model) | margin k=10 | margin k=20 | |")
                 T.append("|---|---:|---|---:|---:|---|")
                 for n, cost, v, g in hits:
                     ok = g["10"] >= 2.0 and g["20"] >= 2.0
@@ -1622,10 +1625,13 @@ def notes(meta, args):
         "predictions to 1e-8 (`run.py selftest`).",
         "- yawcast: `identify` (plain PEM, λ = 0) on the same mean-removed estimation record the peers see "
         "(operating point added back when predicting, as for them); `tune` (GA over λ, R, the paper's recipe: PEM on the clean simulator's record, fitness = k-step fit on the estimation record as the trial); `diagnose` "
-        "against the clean simulator's record, then `augment` with the diagnosed effect (a model with no verdict "
-        "stays plain) — the documented workflow: diagnose gets the model identified on the reference (simulator) "
-        "record, augment re-identifies it with the effect on the estimation record; with no verdict, or when "
-        "augment declines the effect, the row is plain PEM on the raw estimation record. Its models are read from the JSON twin (a, b, k and the effects) and scored by the same "
+        "against the clean simulator's record, then `augment --more` with the diagnosed effect (`--effect none` "
+        "when there is no verdict) — the documented workflow: diagnose gets the model identified on the reference "
+        "(simulator) record, augment re-identifies it with the effect on the estimation record, and `--more` adds "
+        "further library effects one at a time while the held-out last third of the estimation record pays for "
+        "each (the hull's own nonlinear damping, which diagnose rightly does not name: the simulator's records "
+        "need it as much); when the model written carries no effect, the row is plain PEM on the raw estimation "
+        "record. Its models are read from the JSON twin (a, b, k and the effects) and scored by the same "
         "predictor, effects included (dead time → saturation → rate limit, bias, asymmetry, damping, heading "
         "terms, gyro bias), as `host/src/predict.rs` defines them.",
     ]
