@@ -8,8 +8,10 @@ use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
-/// Relative tolerance on the sample spacing before a record counts as non-uniform.
-pub const UNIFORM_TOL: f64 = 1e-3;
+/// Relative distance within which the fitted sample period is snapped to a value with at
+/// most three significant digits (timestamp jitter leaves the fit a hair off the logger's
+/// period, and records identified together must share one sample time).
+pub const SNAP_TOL: f64 = 1e-3;
 
 /// One uniformly sampled record.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -76,9 +78,10 @@ pub enum DataError {
         /// Offending text.
         value: String,
     },
-    /// Time does not advance uniformly.
+    /// Time does not advance one sample per period.
     #[error(
-        "{path}: row {row}: time step {step} s breaks uniform sampling (expected {expected} s)"
+        "{path}: row {row}: time step {step} s breaks uniform sampling (the record's sample \
+         time is {expected} s): {what}"
     )]
     NonUniform {
         /// File concerned.
@@ -87,8 +90,10 @@ pub enum DataError {
         row: usize,
         /// Step found.
         step: f64,
-        /// Step expected.
+        /// The record's sample time (its median step).
         expected: f64,
+        /// What the step means and what to do about it.
+        what: String,
     },
     /// Too few samples to be of any use.
     #[error("{path}: {found} samples, at least {needed} needed")]
@@ -311,30 +316,128 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
         });
     }
     rec.ts = check_uniform(&rec.t, path)?;
+    if let Some(psi) = rec.psi.as_mut() {
+        unwrap_degrees(psi);
+    }
     Ok(rec)
 }
 
-/// Checks that `t` advances by a constant positive step; returns the step.
+/// Removes the 360° jumps of a heading logged in [0, 360) (or (−180, 180]): each sample
+/// moves to within 180° of the one before, so the heading is continuous through north and
+/// its differences are turn angles. Sines and cosines of it are unchanged.
+///
+/// ```
+/// let mut psi = vec![358.0, 359.5, 0.5, 2.0, 1.0, 359.0];
+/// yawcast::data::unwrap_degrees(&mut psi);
+/// assert_eq!(psi, vec![358.0, 359.5, 360.5, 362.0, 361.0, 359.0]);
+/// ```
+pub fn unwrap_degrees(psi: &mut [f64]) {
+    let mut offset = 0.0;
+    for i in 1..psi.len() {
+        let raw = psi[i] + offset;
+        let step = raw - psi[i - 1];
+        let turns = ((step + 180.0) / 360.0).floor();
+        offset -= 360.0 * turns;
+        psi[i] = raw - 360.0 * turns;
+    }
+}
+
+/// Checks that `t` advances one sample per period and returns the period.
+///
+/// The period is the median step. Logged time stamps jitter: a row may come late or early
+/// (the step before it is then longer or shorter, the one after it the opposite), and each
+/// row still holds one sample as long as every step is within half a period of the period —
+/// stamps off their grid by up to a quarter period each. The sample time returned is the
+/// slope of the least-squares line through the stamps, snapped to a value of at most three
+/// significant digits within [`SNAP_TOL`] of it (a logger at 1 Hz with jitter gives 1 s, not
+/// 0.99943 s).
 ///
 /// # Errors
-/// [`DataError::NonUniform`] naming the first row that breaks the step.
+/// [`DataError::NonUniform`] naming the first row whose step is not positive (time going
+/// back or repeated), spans two or more periods (missing samples) or less than half of one
+/// (an extra sample).
+///
+/// ```
+/// use std::path::Path;
+/// let t = [0.0, 1.01, 1.99, 3.0, 4.0, 5.0];
+/// assert_eq!(yawcast::data::check_uniform(&t, Path::new("x.csv")).unwrap(), 1.0);
+/// let gap = [0.0, 1.0, 2.0, 4.0, 5.0];
+/// let e = yawcast::data::check_uniform(&gap, Path::new("x.csv")).unwrap_err();
+/// assert!(e.to_string().contains("row 4") && e.to_string().contains("1 sample missing"));
+/// ```
 pub fn check_uniform(t: &[f64], path: &Path) -> Result<f64, DataError> {
     let n = t.len();
-    let expected = (t[n - 1] - t[0]) / (n - 1) as f64;
-    let first = t[1] - t[0];
-    for i in 1..n {
-        let step = t[i] - t[i - 1];
-        let bad_sign = step <= 0.0 || expected <= 0.0;
-        if bad_sign || (step - first).abs() > UNIFORM_TOL * first.abs().max(1e-12) {
-            return Err(DataError::NonUniform {
-                path: path.to_path_buf(),
-                row: i + 1,
-                step,
-                expected: if expected > 0.0 { expected } else { first },
-            });
+    let mut steps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    let bad = |i: usize, expected: f64, what: String| DataError::NonUniform {
+        path: path.to_path_buf(),
+        row: i + 2,
+        step: t[i + 1] - t[i],
+        expected,
+        what,
+    };
+    if let Some(i) = steps.iter().position(|s| !(*s > 0.0)) {
+        let what = if steps[i] == 0.0 {
+            "the time stamp repeats the row before".to_string()
+        } else {
+            "time goes back".to_string()
+        };
+        return Err(bad(i, t[i] - t[i.saturating_sub(1)], what));
+    }
+    steps.sort_by(f64::total_cmp);
+    let h = if steps.len() % 2 == 1 {
+        steps[steps.len() / 2]
+    } else {
+        0.5 * (steps[steps.len() / 2 - 1] + steps[steps.len() / 2])
+    };
+    for i in 0..n - 1 {
+        let periods = ((t[i + 1] - t[i]) / h).round();
+        if periods >= 2.0 {
+            let missing = periods - 1.0;
+            return Err(bad(
+                i,
+                h,
+                format!(
+                    "{missing} sample{} missing; split the record there or fill the gap",
+                    if missing == 1.0 { "" } else { "s" }
+                ),
+            ));
+        }
+        if periods < 1.0 {
+            return Err(bad(
+                i,
+                h,
+                "less than half a period after the row before (an extra sample); remove it"
+                    .to_string(),
+            ));
         }
     }
-    Ok(expected)
+    // the least-squares slope of t against the sample index
+    let mid = (n - 1) as f64 / 2.0;
+    let t_mean = t.iter().sum::<f64>() / n as f64;
+    let (num, den) = t.iter().enumerate().fold((0.0, 0.0), |(a, b), (i, ti)| {
+        let di = i as f64 - mid;
+        (a + di * (ti - t_mean), b + di * di)
+    });
+    Ok(snap((num / den).max(f64::MIN_POSITIVE)))
+}
+
+/// `ts` rounded to the fewest significant digits (one to three) that move it by at most
+/// [`SNAP_TOL`] (relative); `ts` itself when none does.
+fn snap(ts: f64) -> f64 {
+    for digits in 1..=3 {
+        let k = digits - 1 - ts.log10().floor() as i32;
+        let snapped = if k >= 0 {
+            let s = 10f64.powi(k);
+            (ts * s).round() / s
+        } else {
+            let s = 10f64.powi(-k);
+            (ts / s).round() * s
+        };
+        if (snapped - ts).abs() <= SNAP_TOL * ts {
+            return snapped;
+        }
+    }
+    ts
 }
 
 /// Writes a record as a measurement CSV, atomically (temp file, then rename).
@@ -440,6 +543,32 @@ mod tests {
     }
 
     #[test]
+    fn jittered_time_stamps_keep_the_loggers_period() {
+        // a 2 Hz logger whose stamps jitter by up to ±0.1 s (20 % of a period)
+        let mut txt = String::from("t_s,delta_deg,r_degps\n");
+        for i in 0..200 {
+            let jitter = 0.1 * (((i * 7919) % 11) as f64 / 5.0 - 1.0);
+            txt.push_str(&format!("{},1,0\n", 0.5 * i as f64 + jitter));
+        }
+        let r = parse(&txt).unwrap();
+        assert_eq!(r.ts, 0.5);
+        // a period far from three significant digits is kept as it is
+        let t: Vec<f64> = (0..10).map(|i| i as f64 * 0.123_456_7).collect();
+        let ts = check_uniform(&t, Path::new("x")).unwrap();
+        assert!((ts - 0.123_456_7).abs() < 1e-15, "{ts}");
+    }
+
+    #[test]
+    fn heading_is_unwrapped_through_north() {
+        let r = parse("t_s,delta_deg,r_degps,psi_deg\n0,1,0,359\n1,1,0,1\n2,1,0,3\n3,1,0,0.5\n")
+            .unwrap();
+        assert_eq!(r.psi, Some(vec![359.0, 361.0, 363.0, 360.5]));
+        let mut west = vec![-179.0, 179.0, 170.0, -170.0];
+        unwrap_degrees(&mut west);
+        assert_eq!(west, vec![-179.0, -181.0, -190.0, -170.0]);
+    }
+
+    #[test]
     fn non_uniform_and_non_monotonic_time() {
         let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,1,0\n2.5,1,0\n3.5,1,0\n")
             .unwrap_err()
@@ -447,6 +576,25 @@ mod tests {
         assert!(e.contains("row 3"), "{e}");
         let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,1,0\n0.5,1,0\n").unwrap_err();
         assert!(matches!(e, DataError::NonUniform { row: 3, .. }), "{e}");
+        assert!(e.to_string().contains("time goes back"), "{e}");
+        // a gap of three samples, an extra sample, a repeated stamp: each named with its row
+        let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,1,0\n2,1,0\n6,1,0\n7,1,0\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("row 4")
+                && e.contains("3 samples missing")
+                && e.contains("sample time is 1 s"),
+            "{e}"
+        );
+        let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,1,0\n1.3,1,0\n2,1,0\n3,1,0\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("row 3") && e.contains("extra sample"), "{e}");
+        let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,1,0\n1,1,0\n2,1,0\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("row 3") && e.contains("repeats"), "{e}");
     }
 
     #[test]
