@@ -375,7 +375,7 @@ pub fn check_uniform(t: &[f64], path: &Path) -> Result<f64, DataError> {
         expected,
         what,
     };
-    if let Some(i) = steps.iter().position(|s| !(*s > 0.0)) {
+    if let Some(i) = steps.iter().position(|s| s.is_nan() || *s <= 0.0) {
         let what = if steps[i] == 0.0 {
             "the time stamp repeats the row before".to_string()
         } else {
