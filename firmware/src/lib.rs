@@ -16,7 +16,9 @@
 //! model has a `gyro-bias` effect (otherwise the value is used as is).
 //!
 //! State: `x̂ ∈ R^N`, a delay line of the last `d` commands (`d` = dead time, 0 without the
-//! effect), the actuator position `ũ_prev`, the heading `ψ̂` (deg). All start at zero.
+//! effect), the actuator position `ũ_prev`, the heading `ψ̂` (deg). All start at zero. Steps 2
+//! and 7 and the `ψ̂` term of step 8 apply only to a model with a heading effect (wind or
+//! current), the only readers of `ψ`; otherwise `ψ̂` keeps its value.
 //!
 //! [`Predictor::update_with_heading`]`(u, y, psi)`:
 //! 1. actuator: `δ = u(t−d)` (pop the delay line, push `u`; `δ = u` when `d = 0`);
@@ -34,21 +36,23 @@
 //!    `β_s1·sin r`, `β_c1·cos r`, then current adds `β_s·sin r`, `β_c·cos r`, one term at a time.
 //! 5. `e = y − ŷ` if `y` is finite; otherwise there is no correction
 //!    ([`UpdateStatus::SkippedCorrection`]) and `e = 0`.
-//! 6. `x̂'_i = (x̂_{i+1} + b_i·v) + k_i·e` for `i < N`;
-//!    `x̂'_N = ((…((a_1·x̂_1 + a_2·x̂_2) + a_3·x̂_3) …) + a_N·x̂_N + b_N·v) + k_N·e`.
-//! 7. `ψ̂ = ψ + ts·(y_used − d_y)`.
-//! 8. when `x̂'_1 + … + x̂'_N + ψ̂` (summed left to right) is not finite — a component is
+//! 6. with `s = (…((a_1·x̂_1 + a_2·x̂_2) + a_3·x̂_3) …) + a_N·x̂_N` (the model is in the
+//!    difference form of `yawcast_shared::model`):
+//!    `x̂'_i = ((x̂_i + x̂_{i+1}) + b_i·v) + k_i·e` for `i < N`;
+//!    `x̂'_N = ((x̂_N + s) + b_N·v) + k_N·e`.
+//! 7. `ψ̂ = ψ + ts·(y_used − d_y)` (heading effect only).
+//! 8. when `x̂'_1 + … + x̂'_N (+ ψ̂)` (summed left to right) is not finite — a component is
 //!    NaN or infinite, or the sum leaves the `f32` range — the whole state is reset to zero
 //!    and [`UpdateStatus::NonFiniteReset`] is returned.
 //!
 //! [`Predictor::predict_into`]`(out, future_u)` works on a copy of the state:
 //! `out[0] = x̂_1 + d_y`; for `j = 1..H`, one step as above with `u = future_u[j−1]`,
 //! `y_used = out[j−1]`, `ψ = ψ̂` of the copy and no correction term at all
-//! (`x̂'_i = x̂_{i+1} + b_i·v`, `x̂'_N = Σ a_i x̂_i + b_N·v`), then `out[j] = x̂_1 + d_y`.
+//! (`x̂'_i = (x̂_i + x̂_{i+1}) + b_i·v`, `x̂'_N = (x̂_N + s) + b_N·v`), then `out[j] = x̂_1 + d_y`.
 //! If any step of the copy goes non-finite the call fails and `out` must not be used.
 //!
-//! A model without effects runs a specialised path (a shift and one dot product, no effect
-//! dispatch) that performs exactly the operations above.
+//! A model without effects runs a specialised path (one dot product and the neighbour sums,
+//! no effect dispatch) that performs exactly the operations above.
 #![no_std]
 #![deny(missing_docs)]
 // `v = v + β·φ` is written out so the code reads exactly like the documented evaluation order.
@@ -139,7 +143,8 @@ impl From<ModelError> for PredictorError {
 /// The complete predictor state, for save and restore.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PredictorState<const N: usize> {
-    /// State estimate x̂ (after the last update: x̂(t+1|t)).
+    /// State estimate x̂ after the last update (x̂(t+1|t)), in the model's difference
+    /// coordinates: `x̂_1` is the prediction without `d_y`, `x̂_i` its `(i−1)`-th difference.
     pub x: [f32; N],
     /// Dead-time delay line, a ring of the last `d` commands; only `delay[..d]` is used.
     pub delay: [f32; MAX_DEAD_TIME as usize],
@@ -182,6 +187,8 @@ pub struct Predictor<const N: usize = 4> {
     damp: Option<(f32, bool)>,
     wind: Option<[f32; 4]>,
     current: Option<[f32; 2]>,
+    /// Wind or current: the heading is tracked (steps 2 and 7).
+    heading: bool,
     st: PredictorState<N>,
 }
 
@@ -213,7 +220,7 @@ impl<const N: usize> Predictor<N> {
     /// ```
     /// use yawcast_firmware::{Predictor, PredictorError};
     /// use yawcast_shared::model::{ModelSpec, Units};
-    /// let m = ModelSpec::new(2, 1.0, &[-0.2, 0.5], &[0.1, 0.05], &[0.3, 0.1],
+    /// let m = ModelSpec::new(2, 1.0, &[-0.7, -1.5], &[0.1, -0.05], &[0.3, -0.2],
     ///                        Units::default(), &[]).unwrap();
     /// let p = Predictor::<2>::new(&m).unwrap();
     /// assert_eq!(p.prediction(), 0.0);
@@ -244,6 +251,7 @@ impl<const N: usize> Predictor<N> {
             damp: None,
             wind: None,
             current: None,
+            heading: false,
             st: PredictorState::ZERO,
         };
         p.a.copy_from_slice(&spec.a[..N]);
@@ -274,6 +282,7 @@ impl<const N: usize> Predictor<N> {
                 }
             }
         }
+        p.heading = p.wind.is_some() || p.current.is_some();
         Ok(p)
     }
 
@@ -287,12 +296,12 @@ impl<const N: usize> Predictor<N> {
     /// ```
     /// use yawcast_firmware::{Predictor, UpdateStatus};
     /// use yawcast_shared::model::{ModelSpec, Units};
-    /// let m = ModelSpec::new(2, 1.0, &[-0.25, 0.5], &[0.5, 0.25], &[0.5, 0.125],
+    /// let m = ModelSpec::new(2, 1.0, &[-0.75, -1.5], &[0.5, -0.25], &[0.5, -0.375],
     ///                        Units::default(), &[]).unwrap();
     /// let mut p = Predictor::<2>::new(&m).unwrap();
     /// assert_eq!(p.update(1.0, 2.0), UpdateStatus::Corrected);
-    /// // x̂ = (0 + 0.5·1 + 0.5·2, 0 + 0.25·1 + 0.125·2) = (1.5, 0.5)
-    /// assert_eq!(p.state().x, [1.5, 0.5]);
+    /// // x̂ = ((0 + 0) + 0.5·1 + 0.5·2, (0 + 0) − 0.25·1 − 0.375·2) = (1.5, −1)
+    /// assert_eq!(p.state().x, [1.5, -1.0]);
     /// assert_eq!(p.update(0.0, f32::NAN), UpdateStatus::SkippedCorrection);
     /// assert_eq!(p.update(f32::INFINITY, 0.0), UpdateStatus::NonFiniteReset);
     /// assert_eq!(p.state().x, [0.0, 0.0]);
@@ -312,14 +321,14 @@ impl<const N: usize> Predictor<N> {
     /// ```
     /// use yawcast_firmware::{Predictor, UpdateStatus};
     /// use yawcast_shared::model::{Effect, ModelSpec, Units};
-    /// let m = ModelSpec::new(2, 0.5, &[-0.25, 0.5], &[0.5, 0.25], &[0.5, 0.125],
+    /// let m = ModelSpec::new(2, 0.5, &[-0.75, -1.5], &[0.5, -0.25], &[0.5, -0.375],
     ///                        Units::default(),
     ///                        &[Effect::Current { beta_s: 1.0, beta_c: 0.0 }]).unwrap();
     /// let mut p = Predictor::<2>::new(&m).unwrap();
     /// p.update_with_heading(0.0, 2.0, Some(90.0));
     /// // ψ̂ = 90 + 0.5·2; v = 0 + 1·sin(90°) = 1
     /// assert_eq!(p.state().psi, 91.0);
-    /// assert_eq!(p.state().x, [0.5 + 0.5 * 2.0, 0.25 + 0.125 * 2.0]);
+    /// assert_eq!(p.state().x, [0.5 + 0.5 * 2.0, -0.25 - 0.375 * 2.0]);
     /// ```
     #[inline(never)]
     pub fn update_with_heading(&mut self, u: f32, y: f32, psi: Option<f32>) -> UpdateStatus {
@@ -329,59 +338,43 @@ impl<const N: usize> Predictor<N> {
     #[inline(always)]
     fn update_inner(&mut self, u: f32, y: f32, psi: Option<f32>) -> UpdateStatus {
         if self.plain {
-            self.update_plain(u, y, psi)
+            self.update_plain(u, y)
         } else {
             self.update_general(u, y, psi)
         }
     }
 
-    /// The effect-free update: shift, one dot product, heading integration. A missing
-    /// measurement takes the out-of-line path (same arithmetic with `e = 0`).
+    /// The effect-free update: one dot product and the neighbour sums (no heading: no effect
+    /// reads it). A missing measurement takes the out-of-line path (same arithmetic with
+    /// `e = 0`).
     #[inline(always)]
-    fn update_plain(&mut self, u: f32, y: f32, psi: Option<f32>) -> UpdateStatus {
+    fn update_plain(&mut self, u: f32, y: f32) -> UpdateStatus {
         if y.is_finite() {
             let e = y - self.st.x[0];
-            self.plain_step(u, y, e, psi, UpdateStatus::Corrected)
+            self.plain_step(u, e, UpdateStatus::Corrected)
         } else {
-            self.plain_skip(u, psi)
+            self.plain_skip(u)
         }
     }
 
     #[cold]
     #[inline(never)]
-    fn plain_skip(&mut self, u: f32, psi: Option<f32>) -> UpdateStatus {
-        let yhat = self.st.x[0];
-        self.plain_step(u, yhat, 0.0, psi, UpdateStatus::SkippedCorrection)
+    fn plain_skip(&mut self, u: f32) -> UpdateStatus {
+        self.plain_step(u, 0.0, UpdateStatus::SkippedCorrection)
     }
 
     #[inline(always)]
-    fn plain_step(
-        &mut self,
-        u: f32,
-        y_used: f32,
-        e: f32,
-        psi: Option<f32>,
-        ok: UpdateStatus,
-    ) -> UpdateStatus {
+    fn plain_step(&mut self, u: f32, e: f32, ok: UpdateStatus) -> UpdateStatus {
         let x = self.st.x;
-        let mut last = self.a[0] * x[0];
-        for i in 1..N {
-            last = last + self.a[i] * x[i];
-        }
+        let s = self.row_dot(&x);
         let mut nx = [0.0f32; N];
         for i in 0..N - 1 {
-            nx[i] = x[i + 1] + self.b[i] * u + self.k[i] * e;
+            nx[i] = x[i] + x[i + 1] + self.b[i] * u + self.k[i] * e;
         }
-        nx[N - 1] = last + self.b[N - 1] * u + self.k[N - 1] * e;
-        let heading = match psi {
-            Some(p) if p.is_finite() => p,
-            _ => self.st.psi,
-        };
-        let npsi = heading + self.ts * y_used;
+        nx[N - 1] = x[N - 1] + s + self.b[N - 1] * u + self.k[N - 1] * e;
         self.st.x = nx;
         self.st.u_prev = u;
-        self.st.psi = npsi;
-        self.finish(&nx, npsi, ok)
+        self.finish(&nx, None, ok)
     }
 
     #[inline(never)]
@@ -391,38 +384,53 @@ impl<const N: usize> Predictor<N> {
         let yhat = self.output(&st);
         let (y_used, e) = if finite { (y, y - yhat) } else { (yhat, 0.0) };
         let heading = match psi {
-            Some(p) if p.is_finite() => p,
+            Some(p) if p.is_finite() && self.heading => p,
             _ => st.psi,
         };
         let ut = self.actuator(&mut st, u);
         let v = self.effective_input(ut, y_used, heading);
         let x = st.x;
-        let mut last = self.a[0] * x[0];
-        for i in 1..N {
-            last = last + self.a[i] * x[i];
-        }
+        let s = self.row_dot(&x);
         for i in 0..N - 1 {
-            st.x[i] = x[i + 1] + self.b[i] * v + self.k[i] * e;
+            st.x[i] = x[i] + x[i + 1] + self.b[i] * v + self.k[i] * e;
         }
-        st.x[N - 1] = last + self.b[N - 1] * v + self.k[N - 1] * e;
-        st.psi = heading + self.ts * self.minus_dy(y_used);
+        st.x[N - 1] = x[N - 1] + s + self.b[N - 1] * v + self.k[N - 1] * e;
+        let psi_new = if self.heading {
+            st.psi = heading + self.ts * self.minus_dy(y_used);
+            Some(st.psi)
+        } else {
+            None
+        };
         self.st = st;
         let ok = if finite {
             UpdateStatus::Corrected
         } else {
             UpdateStatus::SkippedCorrection
         };
-        self.finish(&st.x, st.psi, ok)
+        self.finish(&st.x, psi_new, ok)
     }
 
-    /// Step 8: the finiteness check of the new state; `ok` is the status when it passes.
+    /// `s = (…(a_1·x_1 + a_2·x_2) …) + a_N·x_N`, left to right (step 6).
     #[inline(always)]
-    fn finish(&mut self, x: &[f32; N], psi: f32, ok: UpdateStatus) -> UpdateStatus {
+    fn row_dot(&self, x: &[f32; N]) -> f32 {
+        let mut s = self.a[0] * x[0];
+        for i in 1..N {
+            s = s + self.a[i] * x[i];
+        }
+        s
+    }
+
+    /// Step 8: the finiteness check of the new state (`psi`: the new ψ̂ of a model with a
+    /// heading effect); `ok` is the status when it passes.
+    #[inline(always)]
+    fn finish(&mut self, x: &[f32; N], psi: Option<f32>, ok: UpdateStatus) -> UpdateStatus {
         let mut sum = x[0];
         for xi in &x[1..] {
             sum = sum + *xi;
         }
-        sum = sum + psi;
+        if let Some(p) = psi {
+            sum = sum + p;
+        }
         if sum.is_finite() {
             ok
         } else {
@@ -529,13 +537,14 @@ impl<const N: usize> Predictor<N> {
     /// ```
     /// use yawcast_firmware::{Predictor, PredictorError};
     /// use yawcast_shared::model::{ModelSpec, Units};
-    /// let m = ModelSpec::new(2, 1.0, &[-0.25, 0.5], &[0.5, 0.25], &[0.5, 0.125],
+    /// let m = ModelSpec::new(2, 1.0, &[-0.75, -1.5], &[0.5, -0.25], &[0.5, -0.375],
     ///                        Units::default(), &[]).unwrap();
     /// let mut p = Predictor::<2>::new(&m).unwrap();
-    /// p.update(1.0, 2.0); // x̂ = (1.5, 0.5)
+    /// p.update(1.0, 2.0); // x̂ = (1.5, −1)
     /// let mut out = [0.0f32; 3];
     /// p.predict_into(&mut out, &[2.0, 0.0])?;
-    /// // x̂' = (0.5 + 0.5·2, −0.25·1.5 + 0.5·0.5 + 0.25·2) = (1.5, 0.375); then x̂'_1 = 0.375
+    /// // s = −0.75·1.5 − 1.5·(−1) = 0.375; x̂' = ((1.5 − 1) + 0.5·2, (−1 + 0.375) − 0.25·2)
+    /// // = (1.5, −1.125); then x̂'_1 = 1.5 − 1.125 = 0.375
     /// assert_eq!(out, [1.5, 1.5, 0.375]);
     /// assert_eq!(p.predict_into(&mut out, &[2.0]),
     ///            Err(PredictorError::NotEnoughInputs { needed: 2, got: 1 }));
@@ -566,8 +575,8 @@ impl<const N: usize> Predictor<N> {
     }
 
     /// Effect-free prediction. A non-finite value, once in x̂, stays in x̂_N for every later
-    /// step (`a_1·x̂_1` and `b_N·v` always enter it, and `0·∞` is NaN), so checking x̂_N at the
-    /// end covers every step.
+    /// step (x̂_N itself, every `a_i·x̂_i` and `b_N·v` enter it, and `0·∞` is NaN), so checking
+    /// x̂_N at the end covers every step.
     #[inline(always)]
     fn predict_plain(&self, out: &mut [f32], future_u: &[f32]) -> bool {
         let mut x = self.st.x;
@@ -577,14 +586,11 @@ impl<const N: usize> Predictor<N> {
         };
         *first = x[0];
         for (o, &u) in rest.iter_mut().zip(future_u) {
-            let mut last = self.a[0] * x[0];
-            for i in 1..N {
-                last = last + self.a[i] * x[i];
-            }
+            let s = self.row_dot(&x);
             for i in 0..N - 1 {
-                x[i] = x[i + 1] + self.b[i] * u;
+                x[i] = x[i] + x[i + 1] + self.b[i] * u;
             }
-            x[N - 1] = last + self.b[N - 1] * u;
+            x[N - 1] = x[N - 1] + s + self.b[N - 1] * u;
             *o = x[0];
         }
         x[N - 1].is_finite()
@@ -606,15 +612,14 @@ impl<const N: usize> Predictor<N> {
             let ut = self.actuator(&mut st, u);
             let v = self.effective_input(ut, y_used, heading);
             let x = st.x;
-            let mut last = self.a[0] * x[0];
-            for i in 1..N {
-                last = last + self.a[i] * x[i];
-            }
+            let s = self.row_dot(&x);
             for i in 0..N - 1 {
-                st.x[i] = x[i + 1] + self.b[i] * v;
+                st.x[i] = x[i] + x[i + 1] + self.b[i] * v;
             }
-            st.x[N - 1] = last + self.b[N - 1] * v;
-            st.psi = heading + self.ts * self.minus_dy(y_used);
+            st.x[N - 1] = x[N - 1] + s + self.b[N - 1] * v;
+            if self.heading {
+                st.psi = heading + self.ts * self.minus_dy(y_used);
+            }
             prev = self.output(&st);
             *o = prev;
             // outputs can overflow through d_y alone, so each one is checked here
@@ -631,7 +636,7 @@ impl<const N: usize> Predictor<N> {
     /// ```
     /// use yawcast_firmware::Predictor;
     /// use yawcast_shared::model::{Effect, ModelSpec, Units};
-    /// let m = ModelSpec::new(2, 1.0, &[-0.25, 0.5], &[0.5, 0.25], &[0.5, 0.125],
+    /// let m = ModelSpec::new(2, 1.0, &[-0.75, -1.5], &[0.5, -0.25], &[0.5, -0.375],
     ///                        Units::default(), &[Effect::GyroBias { d_y: 0.25 }]).unwrap();
     /// let p = Predictor::<2>::new(&m).unwrap();
     /// assert_eq!(p.prediction(), 0.25);
@@ -648,7 +653,7 @@ impl<const N: usize> Predictor<N> {
     /// ```
     /// use yawcast_firmware::Predictor;
     /// use yawcast_shared::model::{Effect, ModelSpec, Units};
-    /// let m = ModelSpec::new(2, 1.0, &[-0.25, 0.5], &[0.5, 0.25], &[0.5, 0.125],
+    /// let m = ModelSpec::new(2, 1.0, &[-0.75, -1.5], &[0.5, -0.25], &[0.5, -0.375],
     ///                        Units::default(), &[Effect::DeadTime { samples: 2 }]).unwrap();
     /// let mut p = Predictor::<2>::new(&m).unwrap();
     /// p.update(3.0, 0.0);
@@ -671,14 +676,14 @@ impl<const N: usize> Predictor<N> {
     /// ```
     /// use yawcast_firmware::{Predictor, PredictorError};
     /// use yawcast_shared::model::{ModelSpec, Units};
-    /// let m = ModelSpec::new(2, 1.0, &[-0.25, 0.5], &[0.5, 0.25], &[0.5, 0.125],
+    /// let m = ModelSpec::new(2, 1.0, &[-0.75, -1.5], &[0.5, -0.25], &[0.5, -0.375],
     ///                        Units::default(), &[]).unwrap();
     /// let mut p = Predictor::<2>::new(&m).unwrap();
     /// p.update(1.0, 2.0);
     /// let saved = p.state();
     /// p.update(5.0, -1.0);
     /// p.restore(saved)?;
-    /// assert_eq!(p.state().x, [1.5, 0.5]);
+    /// assert_eq!(p.state().x, [1.5, -1.0]);
     /// let mut bad = saved;
     /// bad.x[1] = f32::NAN;
     /// assert_eq!(p.restore(bad), Err(PredictorError::InvalidState));
@@ -711,7 +716,7 @@ impl<const N: usize> Predictor<N> {
     /// ```
     /// use yawcast_firmware::Predictor;
     /// use yawcast_shared::model::{ModelSpec, Units};
-    /// let m = ModelSpec::new(2, 1.0, &[-0.25, 0.5], &[0.5, 0.25], &[0.5, 0.125],
+    /// let m = ModelSpec::new(2, 1.0, &[-0.75, -1.5], &[0.5, -0.25], &[0.5, -0.375],
     ///                        Units::default(), &[]).unwrap();
     /// let mut p = Predictor::<2>::new(&m).unwrap();
     /// p.update(1.0, 2.0);
@@ -730,9 +735,10 @@ mod tests {
     use super::*;
     use yawcast_shared::model::Units;
 
-    const A: [f32; 4] = [-0.1, 0.2, -0.3, 0.6];
-    const B: [f32; 4] = [0.01, 0.02, 0.03, 0.04];
-    const K: [f32; 4] = [0.3, 0.2, 0.1, 0.05];
+    // the shift-form row (−0.1, 0.2, −0.3, 0.6) in difference form (spectral radius 0.57)
+    const A: [f32; 4] = [-0.6, -2.6, -4.5, -3.4];
+    const B: [f32; 4] = [0.01, 0.01, 0.005, 0.002];
+    const K: [f32; 4] = [0.3, -0.1, 0.02, 0.05];
 
     fn model(effects: &[Effect]) -> ModelSpec {
         ModelSpec::new(4, 0.5, &A, &B, &K, Units::default(), effects).unwrap()
@@ -856,8 +862,8 @@ mod tests {
         assert_eq!(seen, [1.0, 2.0, 2.5, 2.5, 1.5, 0.5]);
     }
 
-    /// From the zero state one update gives x̂'_i = (0 + b_i·v) + k_i·e, so v can be checked
-    /// against a hand evaluation of each effect.
+    /// From the zero state one update gives x̂'_i = ((0 + 0) + b_i·v) + k_i·e, so v can be
+    /// checked against a hand evaluation of each effect.
     fn x_after_one(effects: &[Effect], u: f32, y: f32, psi: Option<f32>) -> [f32; 4] {
         let mut p = Predictor::<4>::new(&model(effects)).unwrap();
         p.update_with_heading(u, y, psi);
@@ -930,12 +936,24 @@ mod tests {
 
     #[test]
     fn heading_integrates_rate_minus_gyro_bias() {
-        let m = model(&[Effect::GyroBias { d_y: 0.5 }]);
+        let current = Effect::Current {
+            beta_s: 0.0,
+            beta_c: 0.0,
+        };
+        let m = model(&[Effect::GyroBias { d_y: 0.5 }, current]);
         let mut p = Predictor::<4>::new(&m).unwrap();
         p.update_with_heading(0.0, 2.5, Some(10.0));
         assert_eq!(p.state().psi, 10.0 + 0.5 * (2.5 - 0.5));
         p.update(0.0, 4.5);
         assert_eq!(p.state().psi, 11.0 + 0.5 * 4.0);
+        // without a heading effect nothing reads ψ: it is neither taken nor integrated
+        let mut p = Predictor::<4>::new(&model(&[Effect::GyroBias { d_y: 0.5 }])).unwrap();
+        p.update_with_heading(0.0, 2.5, Some(10.0));
+        p.update(0.0, 4.5);
+        assert_eq!(p.state().psi, 0.0);
+        let mut p = Predictor::<4>::new(&model(&[])).unwrap();
+        p.update_with_heading(0.0, 2.5, Some(10.0));
+        assert_eq!(p.state().psi, 0.0);
     }
 
     #[test]

@@ -344,7 +344,7 @@ pub fn unwrap_degrees(psi: &mut [f64]) {
 
 /// Checks that `t` advances one sample per period and returns the period.
 ///
-/// The period is the median step. Logged time stamps jitter: a row may come late or early
+/// The period is the median of the steps that go forward. Logged time stamps jitter: a row may come late or early
 /// (the step before it is then longer or shorter, the one after it the opposite), and each
 /// row still holds one sample as long as every step is within half a period of the period —
 /// stamps off their grid by up to a quarter period each. The sample time returned is the
@@ -367,48 +367,52 @@ pub fn unwrap_degrees(psi: &mut [f64]) {
 /// ```
 pub fn check_uniform(t: &[f64], path: &Path) -> Result<f64, DataError> {
     let n = t.len();
-    let mut steps: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-    let bad = |i: usize, expected: f64, what: String| DataError::NonUniform {
-        path: path.to_path_buf(),
-        row: i + 2,
-        step: t[i + 1] - t[i],
-        expected,
-        what,
-    };
-    if let Some(i) = steps.iter().position(|s| s.is_nan() || *s <= 0.0) {
-        let what = if steps[i] == 0.0 {
-            "the time stamp repeats the row before".to_string()
-        } else {
-            "time goes back".to_string()
-        };
-        return Err(bad(i, t[i] - t[i.saturating_sub(1)], what));
-    }
+    // the period: the median of the steps that go forward
+    let mut steps: Vec<f64> = t
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|s| *s > 0.0)
+        .collect();
     steps.sort_by(f64::total_cmp);
-    let h = if steps.len() % 2 == 1 {
+    let h = if steps.is_empty() {
+        f64::NAN
+    } else if steps.len() % 2 == 1 {
         steps[steps.len() / 2]
     } else {
         0.5 * (steps[steps.len() / 2 - 1] + steps[steps.len() / 2])
     };
+    // the first row that breaks the sampling, in row order
     for i in 0..n - 1 {
-        let periods = ((t[i + 1] - t[i]) / h).round();
-        if periods >= 2.0 {
-            let missing = periods - 1.0;
-            return Err(bad(
-                i,
-                h,
-                format!(
+        let step = t[i + 1] - t[i];
+        let what = if step.is_nan() || step < 0.0 {
+            Some("time goes back".to_string())
+        } else if step == 0.0 {
+            Some("the time stamp repeats the row before".to_string())
+        } else {
+            let periods = (step / h).round();
+            if periods >= 2.0 {
+                let missing = periods - 1.0;
+                Some(format!(
                     "{missing} sample{} missing; split the record there or fill the gap",
                     if missing == 1.0 { "" } else { "s" }
-                ),
-            ));
-        }
-        if periods < 1.0 {
-            return Err(bad(
-                i,
-                h,
-                "less than half a period after the row before (an extra sample); remove it"
-                    .to_string(),
-            ));
+                ))
+            } else if periods < 1.0 {
+                Some(
+                    "less than half a period after the row before (an extra sample); remove it"
+                        .to_string(),
+                )
+            } else {
+                None
+            }
+        };
+        if let Some(what) = what {
+            return Err(DataError::NonUniform {
+                path: path.to_path_buf(),
+                row: i + 2,
+                step,
+                expected: h,
+                what,
+            });
         }
     }
     // the least-squares slope of t against the sample index

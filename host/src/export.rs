@@ -12,7 +12,7 @@
 //! ```text
 //! yawcast-golden 1
 //! order <n> horizon <H> samples <N>
-//! x0 <n hex words>            initial state restored before the first update
+//! x0 <n hex words>            initial state (difference coordinates) restored first
 //! psi0 <hex>                  initial heading (deg)
 //! <u> <y> <psi|-> <p_1> … <p_H>   one line per sample t
 //! ```
@@ -362,8 +362,10 @@ pub fn export_with(
         }
     }
     let x0 = predict::estimate_x0(model, check);
+    // the firmware's state is in the difference coordinates of the blob's model
+    let x0_fw = crate::model::differences(&x0);
     let psi0 = check.psi.as_ref().map_or(0.0, |p| p[0]);
-    let run = run_firmware(&spec_back, &x0, psi0, check, hmax)?;
+    let run = run_firmware(&spec_back, &x0_fw, psi0, check, hmax)?;
     let mut checks = Vec::new();
     for &k in &cfg.horizons {
         let host = predict::fit(
@@ -409,9 +411,12 @@ pub fn export_with(
             let run = if cfg.golden_horizon == hmax {
                 run
             } else {
-                run_firmware(&spec_back, &x0, psi0, check, cfg.golden_horizon)?
+                run_firmware(&spec_back, &x0_fw, psi0, check, cfg.golden_horizon)?
             };
-            Some((p.clone(), golden_text(&spec_back, &x0, psi0, check, &run)))
+            Some((
+                p.clone(),
+                golden_text(&spec_back, &x0_fw, psi0, check, &run),
+            ))
         }
         None => None,
     };

@@ -9,7 +9,7 @@
 //! ```
 //! use yawcast::hil::NativePredictor;
 //! use yawcast_shared::model::{ModelSpec, Units};
-//! let m = ModelSpec::new(2, 1.0, &[-0.25, 0.5], &[0.5, 0.25], &[0.5, 0.125],
+//! let m = ModelSpec::new(2, 1.0, &[-0.75, -1.5], &[0.5, -0.25], &[0.5, -0.375],
 //!                        Units::default(), &[]).unwrap();
 //! let mut p = NativePredictor::new(&m).unwrap();
 //! p.update(1.0, 2.0, None);
@@ -678,9 +678,9 @@ mod tests {
         ModelSpec::new(
             4,
             0.5,
-            &[-0.086_45, 0.6135, -1.785, 2.25],
-            &[0.02, 0.035, 0.045, 0.05],
-            &[0.55, 0.45, 0.35, 0.25],
+            &[-0.007_95, -0.2065, -1.035, -1.75],
+            &[0.02, 0.015, -0.005, 0.002],
+            &[0.55, -0.1, 0.02, -0.01],
             Units::default(),
             &[],
         )

@@ -487,14 +487,29 @@ impl Model {
         m
     }
 
-    /// Converts to the f32 export schema (validated by the shared crate).
+    /// Converts to the f32 export schema, in its difference form ([`to_difference_form`]),
+    /// rounded to `f32`.
     ///
     /// # Errors
-    /// [`ModelError::Export`] when the shared schema refuses the model (e.g. unstable).
+    /// [`ModelError::Export`] when the model has more effects than the schema holds. The
+    /// schema's own checks (stability after rounding) run when the spec is validated or
+    /// encoded.
+    ///
+    /// ```
+    /// use yawcast::model::Model;
+    /// // shift form z² − 0.5 z + 0.2 (a = (−0.2, 0.5)) is δ² + 1.5 δ + 0.7 in δ = z − 1
+    /// let m = Model::new(1.0, vec![-0.2, 0.5], vec![0.1, 0.05], vec![0.3, 0.1]).unwrap();
+    /// let s = m.to_spec().unwrap();
+    /// assert_eq!(s.a.as_slice(), &[-0.7f32, -1.5]);
+    /// assert_eq!(s.b.as_slice(), &[0.1f32, -0.05]);
+    /// let back = Model::from_spec(&s).unwrap();
+    /// assert!((back.a[0] + 0.2).abs() < 1e-7 && (back.a[1] - 0.5).abs() < 1e-7);
+    /// ```
     pub fn to_spec(&self) -> Result<ModelSpec, ModelError> {
         let cvt = |v: &[f64]| -> heapless::Vec<f32, { sm::MAX_ORDER }> {
             v.iter().map(|x| *x as f32).collect()
         };
+        let (a, b, k) = to_difference_form(&self.a, &self.b, &self.k);
         let mut effects = heapless::Vec::new();
         for e in &self.effects {
             effects
@@ -504,32 +519,106 @@ impl Model {
         let spec = ModelSpec {
             order: self.n as u8,
             ts: self.ts as f32,
-            a: cvt(&self.a),
-            b: cvt(&self.b),
-            k: cvt(&self.k),
+            a: cvt(&a),
+            b: cvt(&b),
+            k: cvt(&k),
             units: Units::default(),
             effects,
         };
         Ok(spec)
     }
 
-    /// Converts from the f32 export schema.
+    /// Converts from the f32 export schema (difference form) back to the shift form, in f64.
     ///
     /// # Errors
     /// [`ModelError`] when the converted model does not validate.
     pub fn from_spec(spec: &ModelSpec) -> Result<Model, ModelError> {
         let f = |v: &[f32]| v.iter().map(|x| f64::from(*x)).collect::<Vec<_>>();
+        let (a, b, k) = from_difference_form(&f(&spec.a), &f(&spec.b), &f(&spec.k));
         let m = Model {
             n: spec.order as usize,
             ts: spec.ts.into(),
-            a: f(&spec.a),
-            b: f(&spec.b),
-            k: f(&spec.k),
+            a,
+            b,
+            k,
             effects: spec.effects.iter().filter_map(Effect::from_spec).collect(),
         };
         m.validate()?;
         Ok(m)
     }
+}
+
+/// Binomial coefficient C(n, k) as f64 (exact for the orders used here).
+fn binomial(n: usize, k: usize) -> f64 {
+    (0..k).fold(1.0, |c, i| c * (n - i) as f64 / (i + 1) as f64)
+}
+
+/// `v ↦ T v` with `(T v)_i = Σ_{m ≤ i} (−1)^{i−m} C(i, m) v_m`: the `i`-th forward difference
+/// of a sequence `v_0, v_1, …` at its start. Maps a shift-form state, input vector or gain
+/// to the difference form.
+///
+/// ```
+/// assert_eq!(yawcast::model::differences(&[1.0, 3.0, 7.0, 13.0]), vec![1.0, 2.0, 2.0, 0.0]);
+/// ```
+pub fn differences(v: &[f64]) -> Vec<f64> {
+    (0..v.len())
+        .map(|i| {
+            (0..=i)
+                .map(|m| {
+                    let sign = if (i - m) % 2 == 0 { 1.0 } else { -1.0 };
+                    sign * binomial(i, m) * v[m]
+                })
+                .sum()
+        })
+        .collect()
+}
+
+/// The inverse of [`differences`]: `v_i = Σ_{m ≤ i} C(i, m) d_m`.
+fn sums(d: &[f64]) -> Vec<f64> {
+    (0..d.len())
+        .map(|i| (0..=i).map(|m| binomial(i, m) * d[m]).sum())
+        .collect()
+}
+
+/// Ascending coefficients of `p(x + s)` from those of `p(x)`.
+fn shift_poly(p: &[f64], s: f64) -> Vec<f64> {
+    (0..p.len())
+        .map(|i| {
+            (i..p.len())
+                .map(|j| p[j] * binomial(j, i) * s.powi((j - i) as i32))
+                .sum()
+        })
+        .collect()
+}
+
+/// The difference form of a shift-form model `(a, b, k)` (the model schema's docs): the
+/// coefficients `g` of its characteristic polynomial in `δ = z − 1`, written as the last
+/// row of `A_δ` (`p(1 + δ) = δ^n − g_n δ^{n−1} − … − g_1`), and `b`, `k` in the coordinates
+/// `z_i = Δ^{i−1} x_1` ([`differences`]). Exact up to f64 rounding; the firmware runs this
+/// form in `f32`, where it keeps poles close to 1 that the shift form's coefficients lose.
+///
+/// ```
+/// use yawcast::model::to_difference_form;
+/// // poles 0.9 and 0.5: z² − 1.4 z + 0.45 → δ² + 0.6 δ + 0.05
+/// let (g, b, k) = to_difference_form(&[-0.45, 1.4], &[1.0, 2.0], &[0.5, 0.25]);
+/// assert!((g[0] + 0.05).abs() < 1e-15 && (g[1] + 0.6).abs() < 1e-15);
+/// assert_eq!((b, k), (vec![1.0, 1.0], vec![0.5, -0.25]));
+/// ```
+pub fn to_difference_form(a: &[f64], b: &[f64], k: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    // p(z) = z^n − Σ a_i z^{i−1}, ascending
+    let mut p: Vec<f64> = a.iter().map(|v| -v).collect();
+    p.push(1.0);
+    let g = shift_poly(&p, 1.0)[..a.len()].iter().map(|v| -v).collect();
+    (g, differences(b), differences(k))
+}
+
+/// The inverse of [`to_difference_form`]: the shift-form `(a, b, k)` of a difference-form
+/// model.
+pub fn from_difference_form(g: &[f64], b: &[f64], k: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let mut p: Vec<f64> = g.iter().map(|v| -v).collect();
+    p.push(1.0);
+    let a = shift_poly(&p, -1.0)[..g.len()].iter().map(|v| -v).collect();
+    (a, sums(b), sums(k))
 }
 
 /// Largest eigenvalue modulus of a square matrix.

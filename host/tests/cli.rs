@@ -116,9 +116,10 @@ fn csv_errors_name_file_row_and_column() {
             &["nan.csv", "row 6", "delta_deg"],
         ),
         (
+            // a stamp 1 s late at 0.5 s sampling (jitter within half a period is accepted)
             "nonuniform.csv",
-            csv_text(40, 0.5).replacen("\n3,", "\n3.2,", 1),
-            &["nonuniform.csv", "row 7", "uniform"],
+            csv_text(40, 0.5).replacen("\n3,", "\n4,", 1),
+            &["nonuniform.csv", "row 7", "uniform", "2 samples missing"],
         ),
     ];
     for (name, text, needles) in cases {

@@ -12,6 +12,10 @@
 //!
 //! [`decode_blob`] checks every part and validates the model (finite, sane, stable), so a
 //! blob that decodes is safe to hand to the firmware predictor.
+//!
+//! Version 2 carries the model in the difference form of [`crate::model`]; version 1 carried
+//! the shift-form companion row, which `f32` cannot hold for poles close to 1, and is refused
+//! ([`BlobError::UnsupportedVersion`]): export the model again.
 
 use crate::crc::crc32;
 use crate::model::{ModelError, ModelSpec};
@@ -19,7 +23,7 @@ use crate::model::{ModelError, ModelSpec};
 /// First four bytes of every blob.
 pub const MAGIC: [u8; 4] = *b"YAWC";
 /// The blob format version this crate writes and reads.
-pub const FORMAT_VERSION: u16 = 1;
+pub const FORMAT_VERSION: u16 = 2;
 /// Bytes before the payload: magic, version, payload length.
 pub const HEADER_LEN: usize = 8;
 /// Bytes after the payload: the CRC.
@@ -107,7 +111,7 @@ impl From<ModelError> for BlobError {
 /// ```
 /// use yawcast_shared::blob::{decode_blob, encode_blob, MAX_BLOB_LEN};
 /// use yawcast_shared::model::{ModelSpec, Units};
-/// let m = ModelSpec::new(2, 1.0, &[-0.2, 0.5], &[0.1, 0.05], &[0.3, 0.1],
+/// let m = ModelSpec::new(2, 1.0, &[-0.7, -1.5], &[0.1, -0.05], &[0.3, -0.2],
 ///                        Units::default(), &[]).unwrap();
 /// let mut buf = [0u8; MAX_BLOB_LEN];
 /// let blob = encode_blob(&m, &mut buf).unwrap();
@@ -145,7 +149,7 @@ pub fn encode_blob<'a>(spec: &ModelSpec, buf: &'a mut [u8]) -> Result<&'a [u8], 
 /// ```
 /// use yawcast_shared::blob::{decode_blob, encode_blob, BlobError, MAX_BLOB_LEN};
 /// use yawcast_shared::model::{ModelSpec, Units};
-/// let m = ModelSpec::new(2, 1.0, &[-0.2, 0.5], &[0.1, 0.05], &[0.3, 0.1],
+/// let m = ModelSpec::new(2, 1.0, &[-0.7, -1.5], &[0.1, -0.05], &[0.3, -0.2],
 ///                        Units::default(), &[]).unwrap();
 /// let mut buf = [0u8; MAX_BLOB_LEN];
 /// let len = encode_blob(&m, &mut buf).unwrap().len();
@@ -204,15 +208,26 @@ mod tests {
     use crate::model::{Effect, Units, MAX_ORDER};
 
     fn full_model() -> ModelSpec {
-        // order 8 with every effect: the largest payload there is.
-        let mut a = [0.0f32; MAX_ORDER];
-        a[MAX_ORDER - 1] = 0.5;
+        // order 8 with every effect: the largest payload there is. (δ + 0.5)⁸: eight poles
+        // at z = 0.5.
+        let a = [
+            -0.003_906_25,
+            -0.0625,
+            -0.4375,
+            -1.75,
+            -4.375,
+            -7.0,
+            -7.0,
+            -4.0,
+        ];
+        let mut k = [0.0f32; MAX_ORDER];
+        k[0] = 0.1;
         ModelSpec::new(
             8,
             0.5,
             &a,
             &[0.1; 8],
-            &[0.01; 8],
+            &k,
             Units::default(),
             &[
                 Effect::Bias { beta: 0.1 },
@@ -263,8 +278,9 @@ mod tests {
         b[0] = b'X';
         assert_eq!(decode_blob(&b[..n]), Err(BlobError::BadMagic));
         let mut b = blob.clone();
-        b[4] = 2;
-        assert_eq!(decode_blob(&b[..n]), Err(BlobError::UnsupportedVersion(2)));
+        // version 1 held the shift-form companion row: refused, never misread
+        b[4] = 1;
+        assert_eq!(decode_blob(&b[..n]), Err(BlobError::UnsupportedVersion(1)));
         let mut b = blob.clone();
         b[6] = 0xFF;
         b[7] = 0x01;
@@ -287,7 +303,7 @@ mod tests {
         // A payload that is not a model, with a correct CRC: order byte then garbage.
         let mut b = [0u8; 16];
         b[..4].copy_from_slice(&MAGIC);
-        b[4..6].copy_from_slice(&1u16.to_le_bytes());
+        b[4..6].copy_from_slice(&FORMAT_VERSION.to_le_bytes());
         b[6..8].copy_from_slice(&4u16.to_le_bytes());
         b[8..12].copy_from_slice(&[4, 0xFF, 0xFF, 0xFF]);
         let crc = crc32(&b[8..12]);
@@ -301,7 +317,7 @@ mod tests {
         let plen = p.len();
         let mut b = [0u8; MAX_BLOB_LEN];
         b[..4].copy_from_slice(&MAGIC);
-        b[4..6].copy_from_slice(&1u16.to_le_bytes());
+        b[4..6].copy_from_slice(&FORMAT_VERSION.to_le_bytes());
         b[6..8].copy_from_slice(&(plen as u16).to_le_bytes());
         b[8..8 + plen].copy_from_slice(&pb[..plen]);
         let crc = crc32(&pb[..plen]);

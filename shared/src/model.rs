@@ -6,18 +6,30 @@
 //!
 //! # The model
 //!
-//! Innovations form in observability canonical parameterisation, order `n`:
+//! Innovations form, order `n`, in the *difference form* of the observability canonical
+//! parameterisation:
 //!
 //! ```text
-//! x(t+1) = A x(t) + B (ũ(t) + Σ_j β_j φ_j(t)) + K e(t)
-//! y(t)   = x_1(t) + d_y + e(t)
-//! A = companion: x_i(t+1) = x_{i+1}(t) for i < n,  x_n(t+1) = Σ a_i x_i(t)
+//! z(t+1) = z(t) + A_δ z(t) + b (ũ(t) + Σ_j β_j φ_j(t)) + k e(t)
+//! y(t)   = z_1(t) + d_y + e(t)
+//! A_δ:  (A_δ z)_i = z_{i+1} for i < n,  (A_δ z)_n = Σ a_i z_i
 //! ```
 //!
 //! `u` is the commanded pod/rudder angle (deg), `y` the yaw rate (deg/s). `ũ` is `u` after the
 //! actuator model: dead time, then saturation of the delayed command, then the rate limit
 //! (the servo slews towards the saturated target), each optional. Every effect that
 //! "enters through B" adds `β φ(t)` to the effective input; `gyro-bias` is the output offset `d_y`.
+//!
+//! The host identifies the model in the shift form of the same parameterisation, `x(t+1) =
+//! A x(t) + …` with `A` the companion matrix of `z^n − a_n z^{n−1} − … − a_1`, `y = x_1 + …`.
+//! The difference form is that model in the coordinates `z_i = Δ^{i−1} x_1` (`z_1 = x_1`,
+//! `z_2 = x_2 − x_1`, `z_3 = x_3 − 2 x_2 + x_1`, …): `I + A_δ` is similar to `A`, and `a` here
+//! holds the coefficients of the characteristic polynomial in `δ = z − 1`. A yaw model sampled
+//! fast against the ship's time constants has poles close to 1, where the shift-form
+//! coefficients cancel to many digits: rounded to `f32` they no longer hold the model (its
+//! steady-state gain `A(1) = 1 − Σ a_i` can be smaller than their rounding error). The
+//! difference-form coefficients measure the poles' distances from 1 directly and keep their
+//! relative precision in `f32`, and the state update adds small increments to the state.
 
 use heapless::Vec;
 use serde::{Deserialize, Serialize};
@@ -249,7 +261,8 @@ impl Effect {
     }
 }
 
-/// A complete model as exported to the controller (all numbers `f32`).
+/// A complete model as exported to the controller (all numbers `f32`), in the difference
+/// form (module docs).
 ///
 /// `a`, `b`, `k` each hold exactly `order` values. Build one with [`ModelSpec::new`], which
 /// validates it; the blob decoder validates again.
@@ -259,11 +272,11 @@ pub struct ModelSpec {
     pub order: u8,
     /// Sample time in seconds, `> 0`.
     pub ts: f32,
-    /// Last row of the companion matrix A: `a_1..a_n` (`x_n(t+1) = Σ a_i x_i(t) + …`).
+    /// Last row of `A_δ`: `a_1..a_n` (`z_n(t+1) = z_n(t) + Σ a_i z_i(t) + …`).
     pub a: Vec<f32, MAX_ORDER>,
-    /// Input vector B.
+    /// Input vector (difference coordinates).
     pub b: Vec<f32, MAX_ORDER>,
-    /// Kalman gain K.
+    /// Kalman gain (difference coordinates).
     pub k: Vec<f32, MAX_ORDER>,
     /// Units of input and output.
     pub units: Units,
@@ -334,7 +347,7 @@ pub enum ModelError {
     EffectParameter(EffectKind),
     /// The same effect kind appears twice.
     DuplicateEffect(EffectKind),
-    /// The companion matrix A has an eigenvalue on or outside the unit circle.
+    /// The state matrix `I + A_δ` has an eigenvalue on or outside the unit circle.
     UnstableModel,
     /// The predictor matrix A − K C has an eigenvalue on or outside the unit circle.
     UnstablePredictor,
@@ -366,7 +379,10 @@ impl core::fmt::Display for ModelError {
                 write!(f, "effect {} appears more than once", kind.name())
             }
             ModelError::UnstableModel => {
-                write!(f, "A has an eigenvalue on or outside the unit circle")
+                write!(
+                    f,
+                    "the state matrix has an eigenvalue on or outside the unit circle"
+                )
             }
             ModelError::UnstablePredictor => write!(
                 f,
@@ -388,14 +404,15 @@ impl ModelSpec {
     ///
     /// ```
     /// use yawcast_shared::model::{Effect, ModelError, ModelSpec, Units};
+    /// // δ² + 1.5 δ + 0.7: poles z = 1 + δ = 0.25 ± 0.37i
     /// let m = ModelSpec::new(
-    ///     2, 1.0, &[-0.2, 0.5], &[0.1, 0.05], &[0.3, 0.1], Units::default(),
+    ///     2, 1.0, &[-0.7, -1.5], &[0.1, -0.05], &[0.3, -0.2], Units::default(),
     ///     &[Effect::Bias { beta: 0.01 }],
     /// )?;
     /// assert_eq!(m.order, 2);
     /// assert_eq!(m.effects.len(), 1);
-    /// // a = (0, 1.5): z² − 1.5 z has the root 1.5, outside the unit circle.
-    /// let bad = ModelSpec::new(2, 1.0, &[0.0, 1.5], &[0.1, 0.0], &[0.0, 0.0],
+    /// // a = (0, 0.5): δ² − 0.5 δ has the root δ = 0.5, the pole z = 1.5.
+    /// let bad = ModelSpec::new(2, 1.0, &[0.0, 0.5], &[0.1, 0.0], &[0.0, 0.0],
     ///                          Units::default(), &[]);
     /// assert_eq!(bad, Err(ModelError::UnstableModel));
     /// # Ok::<(), ModelError>(())
@@ -440,18 +457,19 @@ impl ModelSpec {
     /// magnitude at most [`MAX_MAGNITUDE`]; `0 < ts ≤ MAX_SAMPLE_TIME`; every effect's
     /// parameters are finite and at most [`MAX_MAGNITUDE`] in magnitude, dead time is in
     /// `1..=MAX_DEAD_TIME`, rate and limit are positive; no effect kind appears twice; and
-    /// both A and the predictor A − K C have all eigenvalues strictly inside the unit circle
-    /// (Schur–Cohn test on their characteristic polynomials, in `f64`).
+    /// both the state matrix `I + A_δ` and the predictor matrix `I + A_δ − k e₁ᵀ` have all
+    /// eigenvalues strictly inside the unit circle (Schur–Cohn test on their characteristic
+    /// polynomials in `z`, in `f64`).
     ///
     /// # Errors
     /// The first [`ModelError`] found, in the order listed above.
     ///
     /// ```
     /// use yawcast_shared::model::{ModelError, ModelSpec, Units};
-    /// let mut m = ModelSpec::new(2, 0.5, &[-0.2, 0.5], &[0.1, 0.05], &[0.3, 0.1],
+    /// let mut m = ModelSpec::new(2, 0.5, &[-0.7, -1.5], &[0.1, -0.05], &[0.3, -0.2],
     ///                            Units::default(), &[])?;
     /// assert_eq!(m.validate(), Ok(()));
-    /// // A large gain makes A − K C unstable although A is stable.
+    /// // A large gain makes the predictor unstable although the model is stable.
     /// m.k[0] = 3.0;
     /// assert_eq!(m.validate(), Err(ModelError::UnstablePredictor));
     /// # Ok::<(), ModelError>(())
@@ -491,10 +509,13 @@ impl ModelSpec {
                 return Err(ModelError::EffectParameter(kind));
             }
         }
-        if !schur_stable(&companion_char_poly(&self.a, &[], n), n) {
+        if !schur_stable(&shift_by_one(&companion_char_poly(&self.a, &[], n), n), n) {
             return Err(ModelError::UnstableModel);
         }
-        if !schur_stable(&companion_char_poly(&self.a, &self.k, n), n) {
+        if !schur_stable(
+            &shift_by_one(&companion_char_poly(&self.a, &self.k, n), n),
+            n,
+        ) {
             return Err(ModelError::UnstablePredictor);
         }
         Ok(())
@@ -507,7 +528,7 @@ impl ModelSpec {
     ///
     /// ```
     /// use yawcast_shared::model::{Effect, EffectKind, ModelSpec, Units};
-    /// let m = ModelSpec::new(2, 1.0, &[-0.2, 0.5], &[0.1, 0.05], &[0.3, 0.1],
+    /// let m = ModelSpec::new(2, 1.0, &[-0.7, -1.5], &[0.1, -0.05], &[0.3, -0.2],
     ///                        Units::default(), &[Effect::DeadTime { samples: 2 }]).unwrap();
     /// assert_eq!(m.effect(EffectKind::DeadTime), Some(Effect::DeadTime { samples: 2 }));
     /// assert_eq!(m.effect(EffectKind::Wind), None);
@@ -594,6 +615,33 @@ fn companion_char_poly(a: &[f32], k: &[f32], n: usize) -> Poly {
     out
 }
 
+/// `p(z − 1)` for the monic polynomial `p` of degree `n` (descending powers, as [`Poly`]):
+/// the characteristic polynomial in `z` of `I + M` from that of `M` in `δ`.
+// Element loops over fixed arrays: every index is provably in bounds, no panic path.
+#[allow(clippy::needless_range_loop)]
+fn shift_by_one(p: &Poly, n: usize) -> Poly {
+    let n = n.min(MAX_ORDER);
+    // ascending coefficients of p(δ), then Horner in (z − 1): q ← q·(z − 1) + c
+    let mut q = [0.0f64; MAX_ORDER + 1];
+    for i in 0..=n {
+        let c = p[i];
+        // q·(z − 1): shift up, subtract
+        let mut next = [0.0f64; MAX_ORDER + 1];
+        for j in 0..n {
+            next[j + 1] += q[j];
+            next[j] -= q[j];
+        }
+        next[0] += c;
+        q = next;
+    }
+    // back to descending powers
+    let mut out = [0.0f64; MAX_ORDER + 1];
+    for i in 0..=n {
+        out[i] = q[n - i];
+    }
+    out
+}
+
 /// Schur–Cohn (Levinson step-down) test: `true` when every root of the monic polynomial
 /// `poly` of degree `n` lies strictly inside the unit circle.
 fn schur_stable(poly: &Poly, n: usize) -> bool {
@@ -663,13 +711,55 @@ mod tests {
         assert!(!stable(&[1.0, f64::NAN, 0.0]));
     }
 
+    #[test]
+    fn shift_by_one_moves_every_root_by_one() {
+        // (δ + 0.5)(δ + 0.1) = δ² + 0.6 δ + 0.05 → (z − 0.5)(z − 0.9) = z² − 1.4 z + 0.45
+        let mut p = [0.0; MAX_ORDER + 1];
+        p[..3].copy_from_slice(&[1.0, 0.6, 0.05]);
+        let q = shift_by_one(&p, 2);
+        assert_eq!(&q[..3], &[1.0, -1.4, 0.45]);
+        // δ⁴ → (z − 1)⁴ = z⁴ − 4 z³ + 6 z² − 4 z + 1
+        let mut p = [0.0; MAX_ORDER + 1];
+        p[0] = 1.0;
+        assert_eq!(&shift_by_one(&p, 4)[..5], &[1.0, -4.0, 6.0, -4.0, 1.0]);
+    }
+
+    #[test]
+    fn difference_form_keeps_poles_near_one_apart() {
+        // poles 1 − 1e-6 and 0.9: δ-coefficients 1e-6 scale, stable; the shift-form
+        // coefficients of the same model are 1.9 and −0.9 to seven digits
+        let m = ModelSpec::new(
+            2,
+            1.0,
+            &[-9.99999e-8, -0.100001],
+            &[1.0, 0.0],
+            &[0.0, 0.0],
+            Units::default(),
+            &[],
+        );
+        assert!(m.is_ok(), "{m:?}");
+        // a pole δ = +1e-7 (z = 1 + 1e-7): unstable
+        let m = ModelSpec::new(
+            2,
+            1.0,
+            &[1.0e-8, -0.0999999],
+            &[1.0, 0.0],
+            &[0.0, 0.0],
+            Units::default(),
+            &[],
+        );
+        assert_eq!(m, Err(ModelError::UnstableModel));
+    }
+
+    /// The shift-form model with companion row (−0.1, 0.2, −0.3, 0.6) in difference form
+    /// (spectral radius 0.57).
     fn base() -> ModelSpec {
         ModelSpec::new(
             4,
             0.5,
-            &[-0.1, 0.2, -0.3, 0.6],
-            &[0.01, 0.02, 0.03, 0.04],
-            &[0.1, 0.1, 0.1, 0.1],
+            &[-0.6, -2.6, -4.5, -3.4],
+            &[0.01, 0.01, 0.005, 0.002],
+            &[0.1, 0.01, 0.0, 0.0],
             Units::default(),
             &[],
         )
@@ -732,7 +822,7 @@ mod tests {
             Err(ModelError::DuplicateEffect(EffectKind::Bias))
         );
         let mut m = base();
-        m.a[3] = 1.2;
+        m.a[0] = 0.1;
         assert_eq!(m.validate(), Err(ModelError::UnstableModel));
         let mut m = base();
         m.k[0] = 2.5;

@@ -11,14 +11,15 @@ use crate::wire::{
     MAX_FRAME_LEN,
 };
 
-/// The reference model: order 4 with a two-sample dead time.
+/// The reference model: order 4 with a two-sample dead time, in difference form (the
+/// shift-form companion row (−0.1, 0.2, −0.3, 0.6)).
 fn reference_model() -> ModelSpec {
     ModelSpec::new(
         4,
         0.5,
-        &[-0.1, 0.2, -0.3, 0.6],
-        &[0.01, 0.02, 0.03, 0.04],
-        &[0.1, 0.1, 0.1, 0.1],
+        &[-0.6, -2.6, -4.5, -3.4],
+        &[0.01, 0.01, 0.005, 0.002],
+        &[0.1, 0.01, 0.0, 0.0],
         Units::default(),
         &[Effect::DeadTime { samples: 2 }],
     )
@@ -28,19 +29,19 @@ fn reference_model() -> ModelSpec {
 /// Its blob, byte for byte: header, postcard payload, CRC-32.
 const REFERENCE_BLOB: [u8; 73] = [
     0x59, 0x41, 0x57, 0x43, // "YAWC"
-    0x01, 0x00, // version 1
+    0x02, 0x00, // version 2
     0x3d, 0x00, // payload length 61
     0x04, // order
     0x00, 0x00, 0x00, 0x3f, // ts = 0.5
-    0x04, 0xcd, 0xcc, 0xcc, 0xbd, 0xcd, 0xcc, 0x4c, 0x3e, 0x9a, 0x99, 0x99, 0xbe, 0x9a, 0x99, 0x19,
-    0x3f, // a
-    0x04, 0x0a, 0xd7, 0x23, 0x3c, 0x0a, 0xd7, 0xa3, 0x3c, 0x8f, 0xc2, 0xf5, 0x3c, 0x0a, 0xd7, 0x23,
-    0x3d, // b
-    0x04, 0xcd, 0xcc, 0xcc, 0x3d, 0xcd, 0xcc, 0xcc, 0x3d, 0xcd, 0xcc, 0xcc, 0x3d, 0xcd, 0xcc, 0xcc,
-    0x3d, // k
+    0x04, 0x9a, 0x99, 0x19, 0xbf, 0x66, 0x66, 0x26, 0xc0, 0x00, 0x00, 0x90, 0xc0, 0x9a, 0x99, 0x59,
+    0xc0, // a
+    0x04, 0x0a, 0xd7, 0x23, 0x3c, 0x0a, 0xd7, 0x23, 0x3c, 0x0a, 0xd7, 0xa3, 0x3b, 0x6f, 0x12, 0x03,
+    0x3b, // b
+    0x04, 0xcd, 0xcc, 0xcc, 0x3d, 0x0a, 0xd7, 0x23, 0x3c, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+    0x00, // k
     0x00, 0x00, // units: deg, deg/s
     0x01, 0x02, 0x02, // one effect: DeadTime { samples: 2 }
-    0xe9, 0xc0, 0xc7, 0x51, // CRC-32
+    0xbf, 0x60, 0x5e, 0xe0, // CRC-32
 ];
 
 #[test]
@@ -48,7 +49,7 @@ fn reference_blob_bytes() {
     let mut buf = [0u8; MAX_BLOB_LEN];
     let blob = encode_blob(&reference_model(), &mut buf).unwrap();
     assert_eq!(blob, &REFERENCE_BLOB[..]);
-    assert_eq!(crc32(&REFERENCE_BLOB[8..69]), 0x51c7_c0e9);
+    assert_eq!(crc32(&REFERENCE_BLOB[8..69]), 0xe05e_60bf);
     assert_eq!(decode_blob(&REFERENCE_BLOB), Ok(reference_model()));
 }
 
@@ -306,9 +307,9 @@ fn decoders_survive_100k_random_and_mutated_inputs() {
         ModelSpec::new(
             2,
             1.0,
-            &[-0.2, 0.5],
-            &[0.1, 0.05],
-            &[0.3, 0.1],
+            &[-0.7, -1.5],
+            &[0.1, -0.05],
+            &[0.3, -0.2],
             Units::default(),
             &[
                 Effect::Wind {

@@ -1,8 +1,9 @@
 //! The recorded trajectory and the golden files under `tests/data/`.
 //!
 //! `trajectory.csv` (`t_s,delta_deg,r_degps,psi_deg`) is a deterministic recording: a
-//! seeded PRBS-like command with random switching intervals and three amplitudes driving the
-//! base model (f64, innovations form) with Irwin–Hall noise; the heading integrates the yaw
+//! seeded PRBS-like command with random switching intervals and three amplitudes driving a
+//! plant with the base model's poles (f64, innovations form, shift form) with Irwin–Hall
+//! noise; the heading integrates the yaw
 //! rate. Some yaw-rate samples are missing (`NaN`, one `inf`), some headings too. Values are
 //! written in Rust's shortest round-trip form, so reading them back gives the same bits.
 //!
@@ -73,11 +74,11 @@ impl Rng {
 
 /// Generates the recording (deterministic: same seed, same numbers).
 pub fn generate_trajectory() -> Trajectory {
-    let m = crate::base_model();
-    let a: Vec<f64> = m.a.iter().map(|v| f64::from(*v)).collect();
-    let b: Vec<f64> = m.b.iter().map(|v| f64::from(*v)).collect();
-    let k: Vec<f64> = m.k.iter().map(|v| f64::from(*v)).collect();
-    let ts = f64::from(m.ts);
+    // the plant that made the recording: the base model's poles in shift form, f64
+    let a = [-0.086_45f32, 0.6135, -1.785, 2.25].map(f64::from);
+    let b = [0.02f32, 0.035, 0.045, 0.05].map(f64::from);
+    let k = [0.55f32, 0.45, 0.35, 0.25].map(f64::from);
+    let ts = f64::from(crate::base_model().ts);
     let mut rng = Rng(0x00C0_FFEE_5EED_2021);
     let (mut u, mut y, mut psi) = (Vec::new(), Vec::new(), Vec::new());
     let mut x = [0.0f64; 4];
@@ -121,7 +122,7 @@ pub fn generate_trajectory() -> Trajectory {
         heading += ts * yt;
     }
     Trajectory {
-        ts: m.ts,
+        ts: crate::base_model().ts,
         u,
         y,
         psi,

@@ -18,7 +18,10 @@ pub const HORIZON: usize = 20;
 /// Steps of the trajectory replayed (the recording has HORIZON more for future commands).
 pub const STEPS: usize = 1000;
 
-/// The base 4th-order model: poles 0.95, 0.7, 0.3 ± 0.2i, sample time 0.5 s.
+/// The base 4th-order model: poles 0.95, 0.7, 0.3 ± 0.2i, sample time 0.5 s, in the
+/// difference form of the blob (`δ⁴ + 1.75 δ³ + 1.035 δ² + 0.2065 δ + 0.00795`, the
+/// shift-form companion row (−0.086 45, 0.6135, −1.785, 2.25)); `b` and `k` chosen so that
+/// every entry is non-zero.
 pub fn base_model() -> ModelSpec {
     with_effects(&[])
 }
@@ -31,9 +34,9 @@ pub fn with_effects(effects: &[Effect]) -> ModelSpec {
     ModelSpec::new(
         4,
         0.5,
-        &[-0.086_45, 0.6135, -1.785, 2.25],
-        &[0.02, 0.035, 0.045, 0.05],
-        &[0.55, 0.45, 0.35, 0.25],
+        &[-0.007_95, -0.2065, -1.035, -1.75],
+        &[0.02, 0.015, -0.005, 0.002],
+        &[0.55, -0.1, 0.02, -0.01],
         Units::default(),
         effects,
     )

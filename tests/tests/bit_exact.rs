@@ -139,7 +139,7 @@ fn qemu_predictions_equal_native_and_goldens_bit_for_bit() {
         banner,
         DeviceMessage::Banner {
             protocol: 1,
-            blob_version: 1,
+            blob_version: yawcast_shared::blob::FORMAT_VERSION,
             order: 4,
             model_loaded: false
         }
@@ -271,9 +271,9 @@ fn qemu_answers_bad_input_with_errors_and_keeps_serving() {
     let order2 = ModelSpec::new(
         2,
         0.5,
-        &[-0.2, 0.5],
-        &[0.1, 0.05],
-        &[0.3, 0.1],
+        &[-0.7, -1.5],
+        &[0.1, -0.05],
+        &[0.3, -0.2],
         Default::default(),
         &[],
     )
@@ -367,7 +367,7 @@ fn raw_blob(m: &ModelSpec) -> Vec<u8> {
     let p = postcard_bytes(m, &mut payload);
     let mut out = Vec::new();
     out.extend_from_slice(b"YAWC");
-    out.extend_from_slice(&1u16.to_le_bytes());
+    out.extend_from_slice(&yawcast_shared::blob::FORMAT_VERSION.to_le_bytes());
     out.extend_from_slice(&(p.len() as u16).to_le_bytes());
     out.extend_from_slice(p);
     out.extend_from_slice(&yawcast_shared::crc::crc32(p).to_le_bytes());
