@@ -37,8 +37,10 @@
 //!    estimation records), the gain is merely not negative: a re-identified 4th-order model
 //!    can absorb a short delay into its poles and predict as well, and the physical model is
 //!    then preferred — neither horizon is significantly worse, and it does not validate
-//!    worse than the input model at 10 steps or in simulation. Otherwise the input model is
-//!    returned unchanged, with the reason.
+//!    worse than the input model at 10 steps or in simulation. Otherwise the effect is not
+//!    kept, with the reason, and the model returned is the baseline when it validates better
+//!    than the input model (10 steps better, simulation no worse) — the same structure fitted
+//!    to the records at hand — or else the input model unchanged ([`Written`]).
 //!
 //! # Forward selection
 //!
@@ -132,10 +134,15 @@ pub struct AugmentReport {
     pub effect: EffectKind,
     /// The model with the effect added and re-identified.
     pub candidate: Model,
-    /// `candidate` when kept, else the input model unchanged.
+    /// The model to write: `candidate` when kept; otherwise the model without the effect
+    /// that validates better — the input structure re-identified on the estimation records
+    /// when it beats the input model on the held-out records, else the input model
+    /// unchanged (`written` says which).
     pub model: Model,
     /// Whether the effect was kept.
     pub kept: bool,
+    /// What `model` is.
+    pub written: Written,
     /// Held-out fit % of the input model, keyed by horizon (`"1"`, `"5"`, `"10"`, `"20"`, `"sim"`).
     pub before: BTreeMap<String, f64>,
     /// Held-out fit % of the input structure re-identified on the estimation records.
@@ -156,6 +163,19 @@ pub struct AugmentReport {
     pub std_pct: Vec<f64>,
     /// Physical words with numbers: the effect's size, the fits, the decision and why.
     pub explanation: String,
+}
+
+/// What an augmentation returns as its model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Written {
+    /// The input model unchanged.
+    Input,
+    /// The input structure (no effect added) re-identified on the estimation records: it
+    /// validates better than the input model at 10 steps and no worse in simulation.
+    Refit,
+    /// The input model with the effect(s) added and re-identified.
+    Augmented,
 }
 
 /// Held-out evaluation of one model.
@@ -711,7 +731,51 @@ pub fn augment(
         return Err(AugmentError::AlreadyPresent(kind));
     }
     let prep = prepare(model, est, val, cfg)?;
-    Ok(try_effect(model, kind, est, &prep, cfg))
+    let mut rep = try_effect(model, kind, est, &prep, cfg);
+    if !rep.kept {
+        let (m, written, note) = without_effect(model, est, &prep, cfg);
+        rep.model = m;
+        rep.written = written;
+        if let Some(n) = note {
+            rep.explanation.push_str(&format!(" {n}"));
+        }
+    }
+    Ok(rep)
+}
+
+/// The model to keep when no effect is added: the baseline (the input structure
+/// re-identified on the estimation part, then on the whole estimation records when a part
+/// was held out) when it validates better than the input model at 10 steps and no worse in
+/// simulation on the held-out records, else the input model; with a sentence saying so.
+fn without_effect(
+    model: &Model,
+    est: &[Record],
+    prep: &Prepared,
+    cfg: &AugmentConfig,
+) -> (Model, Written, Option<String>) {
+    let get = |e: &Eval, k: &str| e.mean.get(k).copied().unwrap_or(f64::NAN);
+    let (b10, bsim) = (get(&prep.baseline, "10"), get(&prep.baseline, "sim"));
+    let (i10, isim) = (get(&prep.before, "10"), get(&prep.before, "sim"));
+    if !(b10 > i10 && bsim >= isim) {
+        return (model.clone(), Written::Input, None);
+    }
+    let mut refit = prep.base.model.clone();
+    if prep.held_note.is_some() {
+        if let Ok(full) = reidentify_warm(est, &refit, cfg) {
+            if full.model.is_stable() && round_trips(&full.model) {
+                refit = full.model;
+            }
+        }
+    }
+    if !(refit.is_stable() && round_trips(&refit)) {
+        return (model.clone(), Written::Input, None);
+    }
+    let note = format!(
+        "The model written is the input structure re-identified on the estimation records: \
+         it validates better than the input model on the held-out records (10 steps {i10:.1} \
+         → {b10:.1} %, simulation {isim:.1} → {bsim:.1} %)."
+    );
+    (refit, Written::Refit, Some(note))
 }
 
 /// Checks the model and the records [`augment`] and [`forward`] are given.
@@ -868,14 +932,18 @@ fn try_effect(
     // re-identified structure otherwise absorbs into θ (a delay into extra poles), so the
     // physical model is kept — it predicts as well and can go into the simulator
     let decisive = delta_bic <= DECISIVE_BIC && t10 >= -tc && tsim >= -tc;
-    if !sig && !decisive {
+    let worse = t10 < -tc || tsim < -tc;
+    if !sig && !decisive && !worse {
         reasons.push(format!(
             "the held-out gain over the re-identified model ({g10:+.2} ± {se10:.2} pp at 10 steps, \
              {gsim:+.2} ± {sesim:.2} pp in simulation) is within the record-to-record spread"
         ));
     }
-    if t10 < -tc || tsim < -tc {
-        reasons.push("it predicts significantly worse at 10 steps or in simulation".into());
+    if worse {
+        reasons.push(format!(
+            "it predicts significantly worse than the re-identified model ({g10:+.2} ± \
+             {se10:.2} pp at 10 steps, {gsim:+.2} ± {sesim:.2} pp in simulation)"
+        ));
     }
     for k in ["10", "sim"] {
         if get(&after, k) < get(before, k) {
@@ -970,6 +1038,11 @@ fn try_effect(
         },
         candidate: cand_model,
         kept,
+        written: if kept {
+            Written::Augmented
+        } else {
+            Written::Input
+        },
         before: pick(before),
         baseline: pick(baseline),
         after: pick(&after),
@@ -1023,6 +1096,9 @@ pub struct ForwardReport {
     pub before: BTreeMap<String, f64>,
     /// Held-out fit % of the returned model (before its final refit on whole records).
     pub after: BTreeMap<String, f64>,
+    /// What `model` is: the input with the added effects (`Augmented`), or, when nothing
+    /// was added, as for [`augment`] (`Refit` or `Input`).
+    pub written: Written,
     /// Physical words with numbers: what was added, what each bought, what was not and why.
     pub explanation: String,
 }
@@ -1079,6 +1155,8 @@ pub fn forward(
     let mut added: Vec<EffectKind> = Vec::new();
     let mut before: Option<BTreeMap<String, f64>> = None;
     let mut held_note = None;
+    let mut written = Written::Augmented;
+    let mut refit_note = None;
     loop {
         let todo: Vec<EffectKind> = candidates
             .iter()
@@ -1095,6 +1173,7 @@ pub fn forward(
         }
         let prep = prepare(&current, est, val, cfg)?;
         held_note.clone_from(&prep.held_note);
+        let first_round = rounds.is_empty();
         let reports = crate::par::map(&todo, cfg.parallel, |k| {
             try_effect(&current, *k, est, &prep, cfg)
         });
@@ -1128,8 +1207,19 @@ pub fn forward(
         }
         rounds.push(Round { tried, added: best });
         if done {
+            if first_round {
+                // nothing added at all: the better of the input and its refit
+                let (m, w, note) = without_effect(&current, est, &prep, cfg);
+                current = m;
+                written = w;
+                refit_note = note;
+            }
             break;
         }
+    }
+    if added.is_empty() && written == Written::Augmented {
+        // no candidate to try at all
+        written = Written::Input;
     }
     let before = before.unwrap_or_default();
     let after = rounds
@@ -1137,9 +1227,14 @@ pub fn forward(
         .rev()
         .find_map(|r| r.added.as_ref().map(|a| a.after.clone()))
         .unwrap_or_else(|| before.clone());
-    let explanation = forward_explanation(&current, &added, &rounds, &before, &after, held_note);
+    let mut explanation =
+        forward_explanation(&current, &added, &rounds, &before, &after, held_note);
+    if let Some(n) = refit_note {
+        explanation.push_str(&format!(" {n}"));
+    }
     Ok(ForwardReport {
         model: current,
+        written,
         added,
         rounds,
         before,
@@ -1233,6 +1328,7 @@ fn failed_report(
         candidate,
         model: model.clone(),
         kept: false,
+        written: Written::Input,
         before: before.mean.clone(),
         baseline: baseline.mean.clone(),
         after: nan,
@@ -1824,9 +1920,66 @@ mod tests {
         ] {
             let r = augment(base(), kind, &est, &val, &AugmentConfig::default()).unwrap();
             assert!(!r.kept, "{}: {}", kind.name(), r.explanation);
-            assert_eq!(&r.model, base());
             assert!(r.explanation.contains("Not kept"), "{}", r.explanation);
+            // no effect added: the input model, or its refit where that validates better
+            assert!(r.model.effects.is_empty());
+            match r.written {
+                Written::Input => assert_eq!(&r.model, base()),
+                Written::Refit => {
+                    assert!(r.baseline["10"] > r.before["10"], "{:?}", r.baseline);
+                    assert!(r.explanation.contains("re-identified"), "{}", r.explanation);
+                }
+                Written::Augmented => panic!("{}: written as augmented", kind.name()),
+            }
         }
+    }
+
+    #[test]
+    fn a_declined_effect_leaves_the_refit_when_it_validates_better() {
+        // trials with a hidden 2 s dead time, augmented with the wrong effect (a bias): the
+        // bias is declined, and the model written is the structure re-identified on the
+        // trials (it absorbs part of the delay into its poles), not the reference model
+        let ship = Ship::default_lng();
+        let e = SimEffect::hidden(EffectKind::DeadTime, 1.0);
+        let est = recs(&ship, Some(e), &EST);
+        let val = recs(&ship, Some(e), &VAL);
+        let r = augment(
+            base(),
+            EffectKind::Bias,
+            &est,
+            &val,
+            &AugmentConfig::default(),
+        )
+        .unwrap();
+        assert!(!r.kept, "{}", r.explanation);
+        assert_eq!(r.written, Written::Refit, "{}", r.explanation);
+        assert!(r.model.effects.is_empty());
+        assert!(
+            r.baseline["10"] > r.before["10"] + 1.0,
+            "{:?} {:?}",
+            r.before,
+            r.baseline
+        );
+        // the model written predicts the validation records better than the input model
+        let fit10 = |m: &Model| {
+            let f: Vec<f64> = val
+                .iter()
+                .map(|rec| {
+                    let x0 = predict::estimate_x0(m, rec);
+                    predict::fit(&rec.y, &predict::predict(m, rec, &x0, Horizon::Steps(10)))
+                })
+                .collect();
+            f.iter().sum::<f64>() / f.len() as f64
+        };
+        assert!(
+            fit10(&r.model) > fit10(base()) + 1.0,
+            "{} vs {}",
+            fit10(&r.model),
+            fit10(base())
+        );
+        assert!(r
+            .explanation
+            .contains("The model written is the input structure"));
     }
 
     #[test]

@@ -902,6 +902,7 @@ fn augment_adds_a_dead_time_exports_it_and_writes_the_ship() {
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(v["effect"], "dead-time");
     assert_eq!(v["kept"], true);
+    assert_eq!(v["written"], "augmented");
     for k in ["1", "5", "10", "20", "sim"] {
         assert!(v["before"]["fit"][k].is_number(), "{k}");
         assert!(v["after"]["fit"][k].is_number(), "{k}");
@@ -1060,6 +1061,7 @@ fn augment_more_searches_the_library_and_pins_its_json() {
         serde_json::from_str(&std::fs::read_to_string(&json2).unwrap()).unwrap();
     assert_eq!(w["effect"], "none");
     assert_eq!(w["auto"], false);
+    assert_eq!(w["written"], "augmented");
     assert!(!w["more"]["added"].as_array().unwrap().is_empty(), "{w}");
     assert_eq!(w["effects"], w["more"]["added"]);
 }

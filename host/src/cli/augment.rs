@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::Args;
 use serde::Serialize;
-use yawcast::augment::{self, AugmentConfig, AugmentError, AugmentReport};
+use yawcast::augment::{self, AugmentConfig, AugmentError, AugmentReport, Written};
 use yawcast::data::Record;
 use yawcast::demo::FitSummary;
 use yawcast::export;
@@ -70,6 +70,10 @@ pub struct AugmentSummary {
     pub auto: bool,
     /// Whether it was kept.
     pub kept: bool,
+    /// What the model written is: `"augmented"` (effects added), `"refit"` (no effect added;
+    /// the input structure re-identified on the estimation records validates better than the
+    /// input model) or `"input"` (the input model unchanged).
+    pub written: Written,
     /// The input model on the held-out records.
     pub before: FitSummary,
     /// The input structure re-identified on the estimation records.
@@ -242,6 +246,7 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
     print_report(&rep, t0.elapsed().as_secs_f64());
     let more = search_more(args, &rep.model, &est, &val, &cfg)?;
     let written = more.as_ref().map_or(&rep.model, |f| &f.model);
+    let what = written_kind(rep.kept, rep.written, more.as_ref());
 
     let check = val
         .first()
@@ -253,11 +258,7 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
         "model written to {} and {}{}",
         ex.blob_path.display(),
         ex.json_path.display(),
-        if rep.kept || more.as_ref().is_some_and(|f| !f.added.is_empty()) {
-            ""
-        } else {
-            " (the input model, unchanged)"
-        }
+        describe_written(what)
     );
 
     let mut ship_written = None;
@@ -286,6 +287,7 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
         effect: kind.name().to_string(),
         auto,
         kept: rep.kept,
+        written: what,
         before: FitSummary {
             fit: rep.before.clone(),
         },
@@ -366,22 +368,24 @@ fn write_unchanged(
 ) -> Result<()> {
     let more = search_more(args, model, est, val, cfg)?;
     let written = more.as_ref().map_or(model, |f| &f.model);
+    let what = written_kind(false, Written::Input, more.as_ref());
     let check = val
         .first()
         .or(est.first())
         .context("no record to check the export on")?;
     let ex = export::export(written, &args.out, check)
         .with_context(|| format!("writing the model {}", args.out.display()))?;
-    if more.as_ref().is_some_and(|f| !f.added.is_empty()) {
-        println!(
-            "model written to {} and {}",
-            ex.blob_path.display(),
-            ex.json_path.display()
-        );
-    } else {
+    if what == Written::Input {
         println!(
             "no effect to add: the input model is written unchanged to {}",
             ex.blob_path.display()
+        );
+    } else {
+        println!(
+            "model written to {} and {}{}",
+            ex.blob_path.display(),
+            ex.json_path.display(),
+            describe_written(what)
         );
     }
     if let Some(p) = &args.ship {
@@ -400,6 +404,7 @@ fn write_unchanged(
         "effect": "none",
         "auto": auto,
         "kept": false,
+        "written": what,
         "before": serde_json::Value::Null,
         "after": serde_json::Value::Null,
         "fit_gain_pp": 0.0,
@@ -411,6 +416,31 @@ fn write_unchanged(
         "more": more.as_ref().map(MoreSummary::of),
         "effects": effect_names(written),
     }))
+}
+
+/// What the written model is, from the named effect's decision (`kept`, `written`) and the
+/// `--more` search that started from its model.
+fn written_kind(kept: bool, written: Written, more: Option<&augment::ForwardReport>) -> Written {
+    let added = more.is_some_and(|f| !f.added.is_empty());
+    if kept || added {
+        Written::Augmented
+    } else if written == Written::Refit || more.is_some_and(|f| f.written == Written::Refit) {
+        Written::Refit
+    } else {
+        Written::Input
+    }
+}
+
+/// The note after "model written to …".
+fn describe_written(w: Written) -> &'static str {
+    match w {
+        Written::Augmented => "",
+        Written::Refit => {
+            " (no effect added: the input structure re-identified on these records, which \
+             validates better than the input model)"
+        }
+        Written::Input => " (the input model, unchanged)",
+    }
 }
 
 /// `--effect auto`: the verdict of `diagnose` (`None` for `none`), printed with its reasons.
