@@ -534,12 +534,15 @@ fn identify_average_export_compare_chain() {
         "fit",
         "start",
         "start_choice",
+        "offset",
     ] {
         assert!(v.get(k).is_some(), "identify JSON lacks `{k}`");
     }
     assert!(v["fit"]["5"].as_f64().unwrap() > 95.0, "{v}");
     // a linear record: every start ends in the one minimum, the lowest cost is taken
     assert!(v["start_choice"].is_null(), "{v}");
+    // and it holds no steady offset
+    assert!(v["offset"].is_null(), "{v}");
     let secs = v["identify_s"].as_f64().unwrap();
     assert!(secs > 0.0 && secs < 60.0, "{v}");
 

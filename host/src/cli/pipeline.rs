@@ -162,6 +162,10 @@ pub struct IdentifySummary {
     pub start: pem::Start,
     /// Set when that minimum is not the lowest-cost one: the test that chose it.
     pub start_choice: Option<pem::choose::StartChoice>,
+    /// Set when the records carry a steady offset the plain structure could only hold with
+    /// a pole on the unit circle: the offset effect added instead (`effect`, `value`,
+    /// `radius_without`, `radius_with`, `delta_bic`).
+    pub offset: Option<pem::offset::OffsetChoice>,
 }
 
 /// Runs `identify`.
@@ -231,7 +235,7 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
         }));
     }
     let started = std::time::Instant::now();
-    let rep = pem::identify(&recs, None, &cfg).map_err(input_ident)?;
+    let (rep, offset) = pem::offset::identify(&recs, &cfg).map_err(input_ident)?;
     let model = if horizons.iter().any(|k| *k > 1) {
         let fc = pem::focus::FocusConfig {
             horizons: horizons.clone(),
@@ -267,6 +271,9 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
     );
     if let Some(c) = &rep.choice {
         println!("{}", c.describe(rep.start));
+    }
+    if let Some(o) = &offset {
+        println!("{}", o.describe());
     }
     print_params(&rep.names, &all_params(&model), &rep.std_pct);
     let fit = if val.is_empty() {
@@ -315,6 +322,7 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
         focus_horizons: horizons,
         start: rep.start,
         start_choice: rep.choice.clone(),
+        offset,
     })
 }
 

@@ -1,0 +1,239 @@
+//! An operating point the linear model cannot hold: when the records carry a steady offset
+//! (a yaw moment from a single screw, a current or wind, a rate-gyro offset), the plain
+//! structure has no term for it and the search parks a pole on the unit circle instead —
+//! an integrator that carries the offset through its state. Such a model predicts a few
+//! steps ahead about as well, but it drifts in simulation and its slow mode is an artefact.
+//!
+//! The integrator shows in A, or in the predictor A − KC when the per-record initial state
+//! x̂(0) carries the offset through a predictor that never forgets it. [`identify`]
+//! identifies the plain structure first. When A or A − KC has a pole that does not decay to
+//! 1 % within the mean record length L (`ρ^L > 0.01`, the rule PEM applies to the predictor:
+//! the records cannot tell such a mode from a constant), it identifies the structure again
+//! with each offset effect of the library
+//! — `bias` (a steady moment through B) and `gyro-bias` (an offset on the measured rate) —
+//! and takes the one with the lowest BIC if it beats the plain structure's BIC and no longer
+//! needs the slow pole. Otherwise the plain model stands.
+
+use serde::Serialize;
+use yawcast_shared::model::EffectKind;
+
+use super::{identify_with, IdentError, PemConfig, PemReport};
+use crate::data::Record;
+use crate::model::{Effect, Model};
+
+/// Why an offset effect was added.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OffsetChoice {
+    /// The effect added (`bias` or `gyro-bias`, as its name).
+    pub effect: &'static str,
+    /// Its estimated value (bias: degrees of command; gyro bias: deg/s).
+    pub value: f64,
+    /// Largest pole modulus of A and A − KC without the effect (the pole that stood in for
+    /// the offset).
+    pub radius_without: f64,
+    /// The same with it.
+    pub radius_with: f64,
+    /// BIC with the effect minus BIC without it (negative).
+    pub delta_bic: f64,
+}
+
+impl OffsetChoice {
+    /// One line for the user.
+    ///
+    /// ```
+    /// use yawcast::pem::offset::OffsetChoice;
+    /// let c = OffsetChoice { effect: "bias", value: 2.1, radius_without: 0.9999999,
+    ///                        radius_with: 0.97, delta_bic: -812.0 };
+    /// assert!(c.describe().contains("2.10"));
+    /// ```
+    pub fn describe(&self) -> String {
+        let what = match self.effect {
+            "bias" => format!(
+                "a steady yaw moment equal to {:.2}° of command (`bias`)",
+                self.value
+            ),
+            _ => format!(
+                "an offset of {:+.4} °/s on the measured rate (`gyro-bias`)",
+                self.value
+            ),
+        };
+        format!(
+            "the records carry a steady offset: without a term for it the search held a pole at \
+             {:.7} (an integrator, slower than the records); identified with {what} instead: \
+             largest pole {:.4}, ΔBIC {:+.1}",
+            self.radius_without, self.radius_with, self.delta_bic
+        )
+    }
+}
+
+/// Whether every pole of A and of A − KC decays to 1 % within the mean record length.
+fn settles(model: &Model, recs: &[Record]) -> bool {
+    let len = recs.iter().map(Record::len).sum::<usize>() as f64 / recs.len().max(1) as f64;
+    let (ra, rp) = model.spectral_radii();
+    len * ra.max(rp).ln() <= 0.01f64.ln()
+}
+
+/// [`super::identify`] of the plain structure, with an offset effect added when the plain
+/// model needs an integrator to carry one (module docs). The effect's gain is estimated
+/// with θ; the returned choice is `None` when the plain model stands.
+///
+/// # Errors
+/// As [`super::identify`] for the plain structure (a failed identification with an offset
+/// effect only means the plain model stands).
+///
+/// ```
+/// use yawcast::{data::Record, model::Model, pem, predict};
+/// // a 2nd-order ship without an offset: the plain model stands
+/// let truth = Model::new(1.0, vec![-0.5, 1.4], vec![0.1, 0.05], vec![0.3, 0.1]).unwrap();
+/// let u: Vec<f64> = (0..600).map(|i| if (i / 25) % 2 == 0 { 5.0 } else { -5.0 }).collect();
+/// let mut rec = Record::from_uy("r", 1.0, u, vec![0.0; 600]);
+/// rec.y = predict::simulate(&truth, &rec, &[0.0, 0.0]);
+/// let cfg = pem::PemConfig { order: 2, ..Default::default() };
+/// let (rep, choice) = pem::offset::identify(&[rec], &cfg).unwrap();
+/// assert!(choice.is_none());
+/// assert!((rep.model.a[1] - 1.4).abs() < 1e-6);
+/// ```
+pub fn identify(
+    records: &[Record],
+    cfg: &PemConfig,
+) -> Result<(PemReport, Option<OffsetChoice>), IdentError> {
+    let plain = super::identify(records, None, cfg)?;
+    if settles(&plain.model, records) {
+        return Ok((plain, None));
+    }
+    let radius = |m: &Model| {
+        let (a, p) = m.spectral_radii();
+        a.max(p)
+    };
+    let radius_without = radius(&plain.model);
+    let tried: Vec<(EffectKind, PemReport)> = [EffectKind::Bias, EffectKind::GyroBias]
+        .into_iter()
+        .filter_map(|kind| {
+            let template = plain.model.clone().with_effect(Effect::zero(kind, 0.0));
+            let mut structure = template.clone();
+            structure.a = vec![0.0; structure.n];
+            structure.b = vec![0.0; structure.n];
+            structure.k = vec![0.0; structure.n];
+            // fresh starts for the structure, and the plain optimum with the offset at zero
+            identify_with(records, Some(&structure), &[template], cfg)
+                .ok()
+                .map(|r| (kind, r))
+        })
+        .filter(|(_, r)| settles(&r.model, records) && r.bic < plain.bic)
+        .collect();
+    let Some((kind, rep)) = tried.into_iter().min_by(|a, b| a.1.bic.total_cmp(&b.1.bic)) else {
+        return Ok((plain, None));
+    };
+    let value = match rep.model.effect(kind) {
+        Some(Effect::Bias { beta }) => *beta,
+        Some(Effect::GyroBias { d_y }) => *d_y,
+        _ => f64::NAN,
+    };
+    let choice = OffsetChoice {
+        effect: kind.name(),
+        value,
+        radius_without,
+        radius_with: radius(&rep.model),
+        delta_bic: rep.bic - plain.bic,
+    };
+    Ok((rep, Some(choice)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::predict;
+
+    fn record(truth: &Model, seed: usize) -> Record {
+        // commands held 10–60 s at ±5, ±10, ±20°, deterministic per seed
+        let mut u = Vec::with_capacity(1800);
+        let mut s = 0x9e37_79b9_7f4a_7c15u64 ^ seed as u64;
+        let mut next = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        };
+        while u.len() < 1800 {
+            let level = [5.0, -10.0, 20.0, -5.0, 10.0, -20.0][(next() % 6) as usize];
+            let hold = 10 + (next() % 51) as usize;
+            u.extend(std::iter::repeat_n(level, hold));
+        }
+        u.truncate(1800);
+        let mut rec = Record::from_uy("r", 1.0, u, vec![0.0; 1800]);
+        let x0 = vec![0.0; truth.n];
+        // white measurement noise, σ ≈ 0.05 °/s (sum of four uniforms)
+        let mut noise = move || {
+            (0..4)
+                .map(|_| (next() >> 11) as f64 / (1u64 << 53) as f64)
+                .sum::<f64>()
+                - 2.0
+        };
+        rec.y = predict::simulate(truth, &rec, &x0)
+            .iter()
+            .map(|v| v + 0.085 * noise())
+            .collect();
+        rec
+    }
+
+    /// A slow 4th-order ship (poles 0.985, 0.9, 0.6 ± 0.2i).
+    fn ship() -> Model {
+        let (a, b, k) = crate::model::from_difference_form(
+            &[-0.0003, -0.0242, -0.2935, -0.915],
+            &[1.6e-4, 8e-5, 4e-5, 1.6e-5],
+            &[0.0; 4],
+        );
+        Model::new(1.0, a, b, k).unwrap()
+    }
+
+    #[test]
+    fn a_steady_moment_is_a_bias_not_an_integrator() {
+        let truth = ship().with_effect(Effect::Bias { beta: 2.0 });
+        let recs = [record(&truth, 1), record(&truth, 2)];
+        let cfg = PemConfig::default();
+        let plain = super::super::identify(&recs, None, &cfg).unwrap();
+        let (rep, choice) = identify(&recs, &cfg).unwrap();
+        let c = choice.expect("offset found");
+        // without the effect the search held a pole at the circle
+        assert!(c.radius_without > 0.9999, "{c:?}");
+        assert!(!settles(&plain.model, &recs));
+        // a steady moment and a rate offset look alike in steady state (the heading tells
+        // them apart, in `diagnose`): either holds the offset, the steady output offset of
+        // 2° of command through the ship's gain
+        let steady = |m: &Model| {
+            let r = Record::from_uy("still", 1.0, vec![0.0; 4000], vec![0.0; 4000]);
+            *predict::simulate(m, &r, &vec![0.0; m.n]).last().unwrap()
+        };
+        let want = steady(&truth);
+        assert!(
+            (steady(&rep.model) - want).abs() < 0.05 * want.abs(),
+            "{} vs {want}: {c:?}",
+            steady(&rep.model)
+        );
+        assert!(c.effect == "bias" || c.effect == "gyro-bias", "{c:?}");
+        assert!(c.radius_with < 0.99, "{c:?}");
+        assert!(c.delta_bic < 0.0);
+        // and it simulates a fresh record at least as well as the integrator does
+        let fresh = record(&truth, 3);
+        let sim = |m: &Model| {
+            let x0 = predict::estimate_x0(m, &fresh);
+            predict::fit(&fresh.y, &predict::simulate(m, &fresh, &x0))
+        };
+        assert!(
+            sim(&rep.model) > 95.0 && sim(&rep.model) >= sim(&plain.model) - 0.05,
+            "{} vs {}",
+            sim(&rep.model),
+            sim(&plain.model)
+        );
+    }
+
+    #[test]
+    fn records_without_an_offset_keep_the_plain_model() {
+        let recs = [record(&ship(), 1), record(&ship(), 2)];
+        let cfg = PemConfig::default();
+        let (rep, choice) = identify(&recs, &cfg).unwrap();
+        assert!(choice.is_none(), "{choice:?}");
+        assert_eq!(rep, super::super::identify(&recs, None, &cfg).unwrap());
+        assert!(rep.model.effects.is_empty());
+    }
+}
