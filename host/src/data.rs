@@ -322,6 +322,42 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
     Ok(rec)
 }
 
+/// Warnings about the scale of a record's columns that suggest a unit mix-up: commands that
+/// never leave ±1.6 (radians under a degree header: π/2 rad is 90°) and yaw rates that never
+/// leave ±0.05 °/s while the commands reach 2° (rad/s under a °/s header: a ship turning
+/// visibly does more than 3°/min). Empty when nothing looks wrong.
+///
+/// ```
+/// use yawcast::data::{unit_warnings, Record};
+/// let r = Record::from_uy("r", 1.0, vec![0.1, -0.2, 0.35], vec![0.001, 0.004, -0.002]);
+/// let w = unit_warnings(&r);
+/// assert_eq!(w.len(), 1);
+/// assert!(w[0].contains("radians"));
+/// let r = Record::from_uy("r", 1.0, vec![10.0, -20.0], vec![0.002, -0.01]);
+/// assert!(unit_warnings(&r)[0].contains("rad/s"));
+/// assert!(unit_warnings(&Record::from_uy("r", 1.0, vec![10.0, -20.0], vec![0.4, -0.9])).is_empty());
+/// ```
+pub fn unit_warnings(rec: &Record) -> Vec<String> {
+    let span = |v: &[f64]| {
+        v.iter()
+            .filter(|x| x.is_finite())
+            .fold(0.0f64, |m, x| m.max(x.abs()))
+    };
+    let (du, dy) = (span(&rec.u), span(&rec.y));
+    let mut out = Vec::new();
+    if du > 0.0 && du <= 1.6 {
+        out.push(format!(
+            "the commands never leave ±{du:.3}: if they are radians, give --angle-unit rad"
+        ));
+    } else if du >= 2.0 && dy > 0.0 && dy <= 0.05 {
+        out.push(format!(
+            "the yaw rate never leaves ±{dy:.4} °/s while the commands reach {du:.0}°: if it \
+             is in rad/s, give --rate-unit radps"
+        ));
+    }
+    out
+}
+
 /// Removes the 360° jumps of a heading logged in [0, 360) (or (−180, 180]): each sample
 /// moves to within 180° of the one before, so the heading is continuous through north and
 /// its differences are turn angles. Sines and cosines of it are unchanged.

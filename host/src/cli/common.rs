@@ -189,11 +189,15 @@ impl ReadArgs {
                     || (ext != "csv" && nmea::looks_like_nmea(&text))
             }
         };
-        if is_nmea {
-            Ok(nmea::parse_nmea(&text, path, &name, &self.nmea())?)
+        let rec = if is_nmea {
+            nmea::parse_nmea(&text, path, &name, &self.nmea())?
         } else {
-            Ok(data::parse_csv(&text, path, &name, &self.columns())?)
+            data::parse_csv(&text, path, &name, &self.columns())?
+        };
+        for w in data::unit_warnings(&rec) {
+            eprintln!("warning: {}: {w}", path.display());
         }
+        Ok(rec)
     }
 
     /// Reads several record files, in order.
