@@ -325,7 +325,8 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
 /// Warnings about the scale of a record's columns that suggest a unit mix-up: commands that
 /// never leave ±1.6 (radians under a degree header: π/2 rad is 90°) and yaw rates that never
 /// leave ±0.05 °/s while the commands reach 2° (rad/s under a °/s header: a ship turning
-/// visibly does more than 3°/min). Empty when nothing looks wrong.
+/// visibly does more than 3°/min), and a sample time above a minute (milliseconds under a
+/// seconds header: no yaw predictor samples that slowly). Empty when nothing looks wrong.
 ///
 /// ```
 /// use yawcast::data::{unit_warnings, Record};
@@ -336,6 +337,8 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
 /// let r = Record::from_uy("r", 1.0, vec![10.0, -20.0], vec![0.002, -0.01]);
 /// assert!(unit_warnings(&r)[0].contains("rad/s"));
 /// assert!(unit_warnings(&Record::from_uy("r", 1.0, vec![10.0, -20.0], vec![0.4, -0.9])).is_empty());
+/// let ms = Record::from_uy("r", 1000.0, vec![10.0, -20.0], vec![0.4, -0.9]);
+/// assert!(unit_warnings(&ms)[0].contains("milliseconds"));
 /// ```
 pub fn unit_warnings(rec: &Record) -> Vec<String> {
     let span = |v: &[f64]| {
@@ -345,6 +348,12 @@ pub fn unit_warnings(rec: &Record) -> Vec<String> {
     };
     let (du, dy) = (span(&rec.u), span(&rec.y));
     let mut out = Vec::new();
+    if rec.ts > 60.0 {
+        out.push(format!(
+            "the sample time is {} s: if the time column is in milliseconds, divide it by 1000",
+            rec.ts
+        ));
+    }
     if du > 0.0 && du <= 1.6 {
         out.push(format!(
             "the commands never leave ±{du:.3}: if they are radians, give --angle-unit rad"
