@@ -20,7 +20,12 @@
 //!   effect is *significant* at level α.
 //! - **Every channel.** Heading separates a gyro bias from a yaw moment: over a record,
 //!   `mean(r) − mean(dψ/dt)` equals the rate-sensor offset and is ≈ 0 for a true moment.
-//!   Speed over ground modulated with heading (harmonics in ψ) reveals current and wind.
+//!   Speed over ground modulated with heading (harmonics in ψ) reveals current and wind,
+//!   once what turning does to the speed is taken out: the speed lost in turns and to
+//!   rudder/pod drag (r² and δ² through a bank of first-order lags, 10–270 s, spanning the
+//!   surge time constants of model ships to large ships). A trial whose turning history
+//!   differs from the reference's has a different heading history too, so speed loss left
+//!   in the residual aliases onto the heading harmonics and reads as a current.
 //!   Standard errors of these channel statistics come from block (batch-means) sums, so
 //!   slow disturbances are accounted for.
 //! - **Encompassing test between the top two**: both effects fitted jointly; what each adds
@@ -609,24 +614,25 @@ fn block_len(n: usize) -> usize {
 }
 
 /// Coefficients of (sin ψ, cos ψ, sin 2ψ, cos 2ψ) in speed over ground; nuisance: one
-/// intercept per record and low-passed r² and δ² (speed lost in turns and to pod drag).
-/// `shift[i]` circularly shifts record i's heading against its speed (0: aligned).
-fn sog_harmonics(recs: &[Record], shift: &[usize]) -> Option<DVector<f64>> {
+/// intercept per record and r² and δ² low-passed through each time constant of
+/// [`sog_taus`] (speed lost in turns and to rudder/pod drag, whatever the ship's surge time
+/// constant). `shift[i]` circularly shifts record i's heading against its speed (0: aligned).
+fn sog_harmonics(recs: &[Record], shift: &[usize], taus: &[f64]) -> Option<DVector<f64>> {
     let nr = recs.len();
-    let p = nr + 6;
+    let nt = taus.len();
+    let p = nr + 4 + 2 * nt;
     let mut xtx = DMatrix::<f64>::zeros(p, p);
     let mut xty = DVector::<f64>::zeros(p);
     let mut x = DVector::<f64>::zeros(p);
     for (i, r) in recs.iter().enumerate() {
         let psi = r.psi.as_ref()?;
         let sp = r.speed.as_ref()?;
-        let a = (r.ts / SOG_TAU_S).min(1.0);
-        let (mut lr, mut lu) = (0.0, 0.0);
+        let a: Vec<f64> = taus.iter().map(|tau| (r.ts / tau).min(1.0)).collect();
+        let mut lr = vec![0.0; nt];
+        let mut lu = vec![0.0; nt];
         let n = r.len();
         let sh = shift.get(i).copied().unwrap_or(0) % n.max(1);
         for t in 0..n {
-            lr += a * (r.y[t] * r.y[t] - lr);
-            lu += a * (r.u[t] * r.u[t] - lu);
             let ph = psi[(t + sh) % n].to_radians();
             let h = [ph.sin(), ph.cos(), (2.0 * ph).sin(), (2.0 * ph).cos()];
             x.fill(0.0);
@@ -634,25 +640,59 @@ fn sog_harmonics(recs: &[Record], shift: &[usize]) -> Option<DVector<f64>> {
             for (j, hj) in h.iter().enumerate() {
                 x[nr + j] = *hj;
             }
-            x[nr + 4] = lr;
-            x[nr + 5] = lu;
+            for k in 0..nt {
+                lr[k] += a[k] * (r.y[t] * r.y[t] - lr[k]);
+                lu[k] += a[k] * (r.u[t] * r.u[t] - lu[k]);
+                x[nr + 4 + 2 * k] = lr[k];
+                x[nr + 5 + 2 * k] = lu[k];
+            }
             xtx.ger(1.0, &x, &x, 1.0);
             xty.axpy(sp[t], &x, 1.0);
         }
+    }
+    // the filter bank's columns are strongly correlated: a relative ridge keeps the solve
+    // well posed without moving the (orthogonal) heading harmonics
+    let ridge = 1e-9 * (xtx.trace() / p as f64).max(1e-300);
+    for j in 0..p {
+        xtx[(j, j)] += ridge;
     }
     let beta = xtx.cholesky()?.solve(&xty);
     Some(beta.rows(nr, 4).into_owned())
 }
 
-/// Time constant of the low-pass nuisance regressors of speed over ground (s).
-const SOG_TAU_S: f64 = 20.0;
+/// Time constants (s) of the low-pass nuisance regressors of speed over ground: a surge
+/// equation `(m − X_u̇) u̇ = X(u) + X_rr r² + X_δδ δ² + …` makes the speed lost in turns a
+/// first-order lag of r² and δ² with the surge time constant `T_u = (m − X_u̇)/(−∂X/∂u)`,
+/// which is not known here and spans ≈ 10 s on a model ship to minutes on a large one. A
+/// first-order lag anywhere in 10–270 s is matched closely by a combination of its two
+/// neighbours in this bank (ratio 3); with one fixed time constant the unmatched part of the
+/// speed loss follows the turning history, and with it the heading, and passes for a
+/// current. Time constants longer than a quarter of the shortest record are dropped (the
+/// per-record intercept already takes what they would).
+fn sog_taus<'a>(recs: impl Iterator<Item = &'a Record>) -> Vec<f64> {
+    let shortest = recs
+        .map(|r| r.len() as f64 * r.ts)
+        .fold(f64::INFINITY, f64::min);
+    let mut out: Vec<f64> = SOG_TAUS_S
+        .iter()
+        .copied()
+        .filter(|tau| *tau <= 0.25 * shortest)
+        .collect();
+    if out.is_empty() {
+        out.push(SOG_TAUS_S[0]);
+    }
+    out
+}
+
+/// The bank of surge time constants (s) of [`sog_taus`].
+const SOG_TAUS_S: [f64; 4] = [10.0, 30.0, 90.0, 270.0];
 /// Circular shifts drawn for the null covariance of the speed harmonics.
 const SOG_SHIFTS: usize = 60;
 
 /// Covariance of the harmonics under "no heading dependence": heading circularly shifted
 /// against speed by random amounts (10–90 % of each record), which keeps both series'
 /// own structure.
-fn sog_null_cov(recs: &[Record], rng: &mut ChaCha8Rng) -> Option<DMatrix<f64>> {
+fn sog_null_cov(recs: &[Record], taus: &[f64], rng: &mut ChaCha8Rng) -> Option<DMatrix<f64>> {
     let mut draws = Vec::with_capacity(SOG_SHIFTS);
     for _ in 0..SOG_SHIFTS {
         let sh: Vec<usize> = recs
@@ -662,7 +702,7 @@ fn sog_null_cov(recs: &[Record], rng: &mut ChaCha8Rng) -> Option<DMatrix<f64>> {
                 rng.random_range(n / 10..=(9 * n / 10).max(n / 10 + 1))
             })
             .collect();
-        draws.push(sog_harmonics(recs, &sh)?);
+        draws.push(sog_harmonics(recs, &sh, taus)?);
     }
     let m = draws.len() as f64;
     let mean = draws.iter().fold(DVector::zeros(4), |a, b| a + b) / m;
@@ -697,14 +737,29 @@ struct SogEvidence {
 }
 
 fn sog_evidence(trial: &[Record], reference: &[Record], seed: u64) -> Option<SogEvidence> {
+    sog_evidence_with(
+        trial,
+        reference,
+        seed,
+        &sog_taus(trial.iter().chain(reference)),
+    )
+}
+
+/// [`sog_evidence`] with the nuisance time constants given.
+fn sog_evidence_with(
+    trial: &[Record],
+    reference: &[Record],
+    seed: u64,
+    taus: &[f64],
+) -> Option<SogEvidence> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5047_5f53_4f47);
-    let t = sog_harmonics(trial, &[])?;
-    let vt = sog_null_cov(trial, &mut rng)?;
+    let t = sog_harmonics(trial, &[], taus)?;
+    let vt = sog_null_cov(trial, taus, &mut rng)?;
     let (d, v) = if reference.is_empty() {
         (t, vt)
     } else {
-        let r = sog_harmonics(reference, &[])?;
-        let vr = sog_null_cov(reference, &mut rng)?;
+        let r = sog_harmonics(reference, &[], taus)?;
+        let vr = sog_null_cov(reference, taus, &mut rng)?;
         (t - r, vt + vr)
     };
     Some(SogEvidence {
@@ -1682,6 +1737,30 @@ mod tests {
         assert!(chi2_sf(s.chi1, 2.0) < 1e-6, "{s:?}");
         let n = sog_evidence(&records(None, &[11, 12]), &clean, 3).unwrap();
         assert!(n.amp1 < 0.05, "{n:?}");
+    }
+
+    #[test]
+    fn speed_lost_in_turns_is_not_a_current() {
+        // a slew limit changes the turning history, and with it the heading history, against
+        // the reference's: with one 20 s lag the speed lost in turns that the nuisance
+        // regressors leave aliases onto the heading harmonics and passes for a current
+        // (p < 1e-3 at 2 df, significant at α/9); the bank of surge lags takes it out
+        let reference = records(None, &[300, 301]);
+        let trial = records(Some((EffectKind::RateLimit, 1.0)), &[302, 303]);
+        let one = sog_evidence_with(&trial, &reference, 1, &[20.0]).unwrap();
+        assert!(one.chi1 > 13.8 && one.amp1 > 0.02, "{one:?}");
+        let bank = sog_evidence(&trial, &reference, 1).unwrap();
+        assert!(bank.chi1 < 9.21 && bank.amp1 < 0.01, "{bank:?}");
+        // no hidden effect at all: the same
+        let none = records(None, &[302, 303]);
+        let one = sog_evidence_with(&none, &reference, 1, &[20.0]).unwrap();
+        assert!(one.chi1 > 13.8, "{one:?}");
+        let bank = sog_evidence(&none, &reference, 1).unwrap();
+        assert!(bank.chi1 < 9.21 && bank.amp1 < 0.01, "{bank:?}");
+        assert_eq!(
+            sog_taus(reference.iter().chain(&trial)),
+            vec![10.0, 30.0, 90.0, 270.0]
+        );
     }
 
     #[test]
