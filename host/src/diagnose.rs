@@ -13,25 +13,47 @@
 //!   version of the effect the reference already shows (a linear model of a nonlinear hull
 //!   shows "nonlinear damping" on any data). The trial statistic is measured from that
 //!   version: `D = N·ln(SSE(reference version)/SSE(trial's best))`.
-//! - **Null distribution by parametric bootstrap.** The innovations model with the
-//!   reference version of the effect is simulated with the reference's innovation variance on
-//!   the trial inputs; `D` is recomputed on each replicate and a scaled χ² is fitted to the
+//! - **The reference's own steering gear.** A slow or delayed gear (a slew limit, a dead
+//!   time) is dynamics: the linear model identified on the reference absorbs it into its
+//!   poles, so with θ frozen the reference shows no version of it, and on the trials
+//!   whichever gear effect mimics the gear's lag best on their commands stands out — a
+//!   2 s dead time on a ship whose own gear slews at 4 °/s looked like a slew limit of
+//!   5 °/s, and trials with no hidden effect showed a slew limit. So first the reference's
+//!   own gear dynamics are looked for with θ re-identified ([`crate::augment::forward`] over
+//!   dead time and slew limit on the reference records, its rule for keeping an effect);
+//!   when the reference shows some, every statistic below is measured against the reference
+//!   model with it (`base`), and a trial's departure from the reference's gear is tested as
+//!   that effect's parameter moving. Angle limits are left to the frozen reference version:
+//!   static, they cannot hide in the poles.
+//! - **Null distribution by parametric bootstrap.** The innovations model (with the
+//!   reference's own gear, when it shows one) is simulated with the reference's innovation
+//!   variance on the reference and trial inputs; `D` is recomputed on each replicate and a scaled χ² is fitted to the
 //!   replicates (Satterthwaite), which gives the p-value. No threshold is set by hand: an
 //!   effect is *significant* at level α.
 //! - **Every channel.** Heading separates a gyro bias from a yaw moment: over a record,
 //!   `mean(r) − mean(dψ/dt)` equals the rate-sensor offset and is ≈ 0 for a true moment.
-//!   Speed over ground modulated with heading (harmonics in ψ) reveals current and wind.
+//!   Speed over ground modulated with heading (harmonics in ψ) reveals current and wind,
+//!   once what turning does to the speed is taken out: the speed lost in turns and to
+//!   rudder/pod drag (r² and δ² through a bank of first-order lags, 10–270 s, spanning the
+//!   surge time constants of model ships to large ships). A trial whose turning history
+//!   differs from the reference's has a different heading history too, so speed loss left
+//!   in the residual aliases onto the heading harmonics and reads as a current.
 //!   Standard errors of these channel statistics come from block (batch-means) sums, so
 //!   slow disturbances are accounted for.
-//! - **Encompassing test between the top two**: both effects fitted jointly; what each adds
-//!   given the other decides between look-alikes (dead time vs slew limit, bias vs current
-//!   vs wind).
+//! - **Encompassing test between the top two**: both effects fitted jointly, each over its
+//!   whole grid; what each adds given the other, beyond the version the reference shows,
+//!   decides between look-alikes (dead time vs slew limit, bias vs current vs wind).
+//! - **Ranking.** Effects are ranked by their likelihood gain above noise (`D` less its null
+//!   mean; a channel's χ² less its degrees of freedom): p-values far in the tail rest on the
+//!   shape fitted to a few dozen null replicates and cannot be compared between effects.
 //! - **Significant and material.** Each effect is judged at level α/m (m effects tested,
 //!   Bonferroni), and reported only when it also improves held-out prediction (θ frozen, the
 //!   effect's gains fitted on the estimation part, fit at 10 steps or in simulation) — or, for
 //!   effects the yaw prediction cannot see well, when its own channel shows it (heading for
-//!   a gyro bias, speed over ground for current and wind). The verdict's effect is then
-//!   refitted with the model ([`crate::augment::augment`]) for the before/after fits.
+//!   a gyro bias, speed over ground for current and wind). An effect that speed over ground
+//!   alone shows (no heading-dependent yaw moment) and that buys no held-out yaw-rate
+//!   prediction is not named ahead of a significant effect that does. The verdict's effect
+//!   is then refitted with the model ([`crate::augment::augment`]) for the before/after fits.
 //! - **Current or wind.** A uniform current carries the ship: speed over ground varies with
 //!   heading by the current's speed (first harmonic), but the hull sees the same water
 //!   whatever its heading, so the current adds (almost) no heading-dependent yaw moment. Wind
@@ -110,6 +132,11 @@ pub struct Ranked {
     pub statistic: f64,
     /// p-value against the calibrated null.
     pub p_value: f64,
+    /// Likelihood gain above what noise alone gives: the statistic less its null mean (for
+    /// a channel statistic, its χ² less its degrees of freedom). Effects are ranked by it:
+    /// far-tail p-values rest on the shape fitted to the null replicates and are not
+    /// comparable between effects.
+    pub above_noise: f64,
     /// Held-out fit gain (percentage points, at the effect's horizon: 10 steps for actuator and
     /// hull effects, `sim` for slow ones) of the model with the effect added (θ frozen, the
     /// effect's gains fitted on the estimation part); 0 for effects that are not significant.
@@ -275,22 +302,39 @@ impl Quad {
 const FD_STEP: f64 = 1e-3;
 
 fn quad_of(model: &Model, cand: &Effect, rec: &Record, x0: &[f64], h: usize) -> Quad {
-    let m0 = model.clone().with_effect(*cand);
-    let e0 = errors(&m0, rec, x0, h);
-    let p = cand.gains().len();
+    quad_multi(model, std::slice::from_ref(cand), rec, x0, h)
+}
+
+/// [`quad_of`] for several effects added together, their gains fitted jointly (in the order
+/// of `cands`, each effect's gains in [`Effect::gains`] order).
+fn quad_multi(model: &Model, cands: &[Effect], rec: &Record, x0: &[f64], h: usize) -> Quad {
+    let zero: Vec<Vec<f64>> = cands.iter().map(|c| vec![0.0; c.gains().len()]).collect();
+    let with = |gains: &[Vec<f64>]| {
+        let mut m = model.clone();
+        for (c, g) in cands.iter().zip(gains) {
+            let mut c = *c;
+            if !g.is_empty() {
+                c.set_gains(g);
+            }
+            m = m.with_effect(c);
+        }
+        m
+    };
+    let e0 = errors(&with(&zero), rec, x0, h);
+    let p: usize = zero.iter().map(Vec::len).sum();
     let mut cols = Vec::with_capacity(p);
-    for j in 0..p {
-        let mut g = vec![0.0; p];
-        g[j] = FD_STEP;
-        let mut c = *cand;
-        c.set_gains(&g);
-        let ej = errors(&model.clone().with_effect(c), rec, x0, h);
-        cols.push(
-            e0.iter()
-                .zip(&ej)
-                .map(|(a, b)| (a - b) / FD_STEP)
-                .collect::<Vec<f64>>(),
-        );
+    for (k, g) in zero.iter().enumerate() {
+        for j in 0..g.len() {
+            let mut gains = zero.clone();
+            gains[k][j] = FD_STEP;
+            let ej = errors(&with(&gains), rec, x0, h);
+            cols.push(
+                e0.iter()
+                    .zip(&ej)
+                    .map(|(a, b)| (a - b) / FD_STEP)
+                    .collect::<Vec<f64>>(),
+            );
+        }
     }
     let mut q = Quad::zero(p);
     q.n = e0.len();
@@ -391,6 +435,25 @@ impl<'a> Set<'a> {
             q
         };
         crate::par::map(cands, parallel, one)
+    }
+
+    /// Quads of every pair of candidates (both added, their gains fitted jointly), summed
+    /// over records.
+    fn pairs(
+        &self,
+        model: &Model,
+        pairs: &[(Effect, Effect)],
+        h: usize,
+        parallel: bool,
+    ) -> Vec<Quad> {
+        let one = |(a, b): &(Effect, Effect)| {
+            let mut q = Quad::zero(a.gains().len() + b.gains().len());
+            for (r, x0) in self.recs.iter().zip(&self.x0) {
+                q.add(&quad_multi(model, &[*a, *b], r, x0, h));
+            }
+            q
+        };
+        crate::par::map(pairs, parallel, one)
     }
 
     /// SSE of the base model at horizon h.
@@ -609,24 +672,25 @@ fn block_len(n: usize) -> usize {
 }
 
 /// Coefficients of (sin ψ, cos ψ, sin 2ψ, cos 2ψ) in speed over ground; nuisance: one
-/// intercept per record and low-passed r² and δ² (speed lost in turns and to pod drag).
-/// `shift[i]` circularly shifts record i's heading against its speed (0: aligned).
-fn sog_harmonics(recs: &[Record], shift: &[usize]) -> Option<DVector<f64>> {
+/// intercept per record and r² and δ² low-passed through each time constant of
+/// [`sog_taus`] (speed lost in turns and to rudder/pod drag, whatever the ship's surge time
+/// constant). `shift[i]` circularly shifts record i's heading against its speed (0: aligned).
+fn sog_harmonics(recs: &[Record], shift: &[usize], taus: &[f64]) -> Option<DVector<f64>> {
     let nr = recs.len();
-    let p = nr + 6;
+    let nt = taus.len();
+    let p = nr + 4 + 2 * nt;
     let mut xtx = DMatrix::<f64>::zeros(p, p);
     let mut xty = DVector::<f64>::zeros(p);
     let mut x = DVector::<f64>::zeros(p);
     for (i, r) in recs.iter().enumerate() {
         let psi = r.psi.as_ref()?;
         let sp = r.speed.as_ref()?;
-        let a = (r.ts / SOG_TAU_S).min(1.0);
-        let (mut lr, mut lu) = (0.0, 0.0);
+        let a: Vec<f64> = taus.iter().map(|tau| (r.ts / tau).min(1.0)).collect();
+        let mut lr = vec![0.0; nt];
+        let mut lu = vec![0.0; nt];
         let n = r.len();
         let sh = shift.get(i).copied().unwrap_or(0) % n.max(1);
         for t in 0..n {
-            lr += a * (r.y[t] * r.y[t] - lr);
-            lu += a * (r.u[t] * r.u[t] - lu);
             let ph = psi[(t + sh) % n].to_radians();
             let h = [ph.sin(), ph.cos(), (2.0 * ph).sin(), (2.0 * ph).cos()];
             x.fill(0.0);
@@ -634,25 +698,59 @@ fn sog_harmonics(recs: &[Record], shift: &[usize]) -> Option<DVector<f64>> {
             for (j, hj) in h.iter().enumerate() {
                 x[nr + j] = *hj;
             }
-            x[nr + 4] = lr;
-            x[nr + 5] = lu;
+            for k in 0..nt {
+                lr[k] += a[k] * (r.y[t] * r.y[t] - lr[k]);
+                lu[k] += a[k] * (r.u[t] * r.u[t] - lu[k]);
+                x[nr + 4 + 2 * k] = lr[k];
+                x[nr + 5 + 2 * k] = lu[k];
+            }
             xtx.ger(1.0, &x, &x, 1.0);
             xty.axpy(sp[t], &x, 1.0);
         }
+    }
+    // the filter bank's columns are strongly correlated: a relative ridge keeps the solve
+    // well posed without moving the (orthogonal) heading harmonics
+    let ridge = 1e-9 * (xtx.trace() / p as f64).max(1e-300);
+    for j in 0..p {
+        xtx[(j, j)] += ridge;
     }
     let beta = xtx.cholesky()?.solve(&xty);
     Some(beta.rows(nr, 4).into_owned())
 }
 
-/// Time constant of the low-pass nuisance regressors of speed over ground (s).
-const SOG_TAU_S: f64 = 20.0;
+/// Time constants (s) of the low-pass nuisance regressors of speed over ground: a surge
+/// equation `(m − X_u̇) u̇ = X(u) + X_rr r² + X_δδ δ² + …` makes the speed lost in turns a
+/// first-order lag of r² and δ² with the surge time constant `T_u = (m − X_u̇)/(−∂X/∂u)`,
+/// which is not known here and spans ≈ 10 s on a model ship to minutes on a large one. A
+/// first-order lag anywhere in 10–270 s is matched closely by a combination of its two
+/// neighbours in this bank (ratio 3); with one fixed time constant the unmatched part of the
+/// speed loss follows the turning history, and with it the heading, and passes for a
+/// current. Time constants longer than a quarter of the shortest record are dropped (the
+/// per-record intercept already takes what they would).
+fn sog_taus<'a>(recs: impl Iterator<Item = &'a Record>) -> Vec<f64> {
+    let shortest = recs
+        .map(|r| r.len() as f64 * r.ts)
+        .fold(f64::INFINITY, f64::min);
+    let mut out: Vec<f64> = SOG_TAUS_S
+        .iter()
+        .copied()
+        .filter(|tau| *tau <= 0.25 * shortest)
+        .collect();
+    if out.is_empty() {
+        out.push(SOG_TAUS_S[0]);
+    }
+    out
+}
+
+/// The bank of surge time constants (s) of [`sog_taus`].
+const SOG_TAUS_S: [f64; 4] = [10.0, 30.0, 90.0, 270.0];
 /// Circular shifts drawn for the null covariance of the speed harmonics.
 const SOG_SHIFTS: usize = 60;
 
 /// Covariance of the harmonics under "no heading dependence": heading circularly shifted
 /// against speed by random amounts (10–90 % of each record), which keeps both series'
 /// own structure.
-fn sog_null_cov(recs: &[Record], rng: &mut ChaCha8Rng) -> Option<DMatrix<f64>> {
+fn sog_null_cov(recs: &[Record], taus: &[f64], rng: &mut ChaCha8Rng) -> Option<DMatrix<f64>> {
     let mut draws = Vec::with_capacity(SOG_SHIFTS);
     for _ in 0..SOG_SHIFTS {
         let sh: Vec<usize> = recs
@@ -662,7 +760,7 @@ fn sog_null_cov(recs: &[Record], rng: &mut ChaCha8Rng) -> Option<DMatrix<f64>> {
                 rng.random_range(n / 10..=(9 * n / 10).max(n / 10 + 1))
             })
             .collect();
-        draws.push(sog_harmonics(recs, &sh)?);
+        draws.push(sog_harmonics(recs, &sh, taus)?);
     }
     let m = draws.len() as f64;
     let mean = draws.iter().fold(DVector::zeros(4), |a, b| a + b) / m;
@@ -697,14 +795,29 @@ struct SogEvidence {
 }
 
 fn sog_evidence(trial: &[Record], reference: &[Record], seed: u64) -> Option<SogEvidence> {
+    sog_evidence_with(
+        trial,
+        reference,
+        seed,
+        &sog_taus(trial.iter().chain(reference)),
+    )
+}
+
+/// [`sog_evidence`] with the nuisance time constants given.
+fn sog_evidence_with(
+    trial: &[Record],
+    reference: &[Record],
+    seed: u64,
+    taus: &[f64],
+) -> Option<SogEvidence> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5047_5f53_4f47);
-    let t = sog_harmonics(trial, &[])?;
-    let vt = sog_null_cov(trial, &mut rng)?;
+    let t = sog_harmonics(trial, &[], taus)?;
+    let vt = sog_null_cov(trial, taus, &mut rng)?;
     let (d, v) = if reference.is_empty() {
         (t, vt)
     } else {
-        let r = sog_harmonics(reference, &[])?;
-        let vr = sog_null_cov(reference, &mut rng)?;
+        let r = sog_harmonics(reference, &[], taus)?;
+        let vr = sog_null_cov(reference, taus, &mut rng)?;
         (t - r, vt + vr)
     };
     Some(SogEvidence {
@@ -739,6 +852,11 @@ struct Evidence {
     words: String,
     parameter: Option<f64>,
     channel_material: bool,
+    /// The version of the effect the reference shows (θ frozen), if any.
+    reference: Option<Effect>,
+    /// Current or wind shown by speed over ground while the yaw channel shows no
+    /// heading-dependent moment ([`current_or_wind`]).
+    speed_only: bool,
 }
 
 /// Diagnoses which library effect `model` is missing on the trial records `est`.
@@ -778,6 +896,14 @@ pub fn diagnose(
     }
     let reps = cfg.null_reps.max(8);
     let has_ref = !reference.is_empty();
+    // The reference's own actuator physics (module docs): the statistics are measured against
+    // the reference model that carries it, `base`; `model` is what the user gave.
+    let gear = if has_ref {
+        reference_actuator(model, reference, cfg)
+    } else {
+        None
+    };
+    let base = gear.as_ref().map_or(model, |g| &g.model);
     let trial = Set::new(model, est);
     let refset = Set::from_owned(model, reference);
     let all = est.iter().chain(reference);
@@ -818,6 +944,17 @@ pub fn diagnose(
     } else {
         None
     };
+    let (trial, refset) = if gear.is_some() {
+        (Set::new(base, est), Set::new(base, reference))
+    } else {
+        (trial, refset)
+    };
+    let sigma = if gear.is_some() {
+        let (s, n) = refset.sse0(base, 1);
+        (s / n.max(1) as f64).sqrt()
+    } else {
+        sigma
+    };
 
     let kinds: Vec<EffectKind> = EffectKind::ALL
         .iter()
@@ -855,9 +992,9 @@ pub fn diagnose(
         .iter()
         .map(|&k| (k, grid(k, model.ts, u_max, du_max)))
         .collect();
-    let real = world(model, reference, est, &grids, cfg.parallel);
+    let real = world(base, reference, est, &grids, cfg.parallel);
     let nulls = bootstrap(
-        model,
+        base,
         reference,
         est,
         &grids,
@@ -869,7 +1006,16 @@ pub fn diagnose(
     let evidence: Vec<Evidence> = kinds
         .iter()
         .enumerate()
-        .map(|(i, &kind)| effect_evidence(model, kind, &real[i], &nulls[i], has_ref, cfg, hb, sog))
+        .map(|(i, &kind)| {
+            let mut e = effect_evidence(base, kind, &real[i], &nulls[i], has_ref, cfg, hb, sog);
+            if let Some(own) = base.effect(kind).filter(|_| gear.is_some()) {
+                e.words.push_str(&format!(
+                    " (the reference's own: {})",
+                    crate::augment::describe(own, model.ts)
+                ));
+            }
+            e
+        })
         .collect();
     let mut ev = evidence;
     let level = cfg.alpha / cfg_m(cfg);
@@ -883,9 +1029,10 @@ pub fn diagnose(
     });
     current_or_wind(&mut ev, level, cfg.alpha, sog.is_some());
     encompass(
-        model,
+        base,
         &trial,
         &mut ev,
+        &grids,
         level,
         cfg.alpha,
         cfg.parallel,
@@ -901,25 +1048,34 @@ pub fn diagnose(
         (est.to_vec(), val.to_vec())
     };
     let before = mean_fit(model, &held_out, &Horizon::REPORT);
-    let est_set = Set::new(model, &est_part);
+    let base_before = if gear.is_some() {
+        mean_fit(base, &held_out, &Horizon::REPORT)
+    } else {
+        before.clone()
+    };
+    let est_set = Set::new(base, &est_part);
+    let mut gains: Vec<Option<(f64, BTreeMap<String, f64>)>> = ev
+        .iter()
+        .map(|e| {
+            (e.p < level)
+                .then(|| frozen_gain(base, e, &est_set, &held_out, &base_before, cfg.parallel))
+        })
+        .collect();
+    yaw_before_speed(&mut ev, &mut gains);
     let mut ranking = Vec::new();
     let mut verdict: Option<(usize, BTreeMap<String, f64>)> = None;
-    for (i, e) in ev.iter().enumerate() {
+    for (i, (e, g)) in ev.iter().zip(&gains).enumerate() {
         let significant = e.p < level;
-        let mut fit_gain = 0.0;
-        let mut material = significant && e.channel_material;
-        if significant {
-            let (gain, fits) = frozen_gain(model, e, &est_set, &held_out, &before, cfg.parallel);
-            fit_gain = gain;
-            material |= gain > 0.0;
-            if material && verdict.is_none() {
-                verdict = Some((i, fits));
-            }
+        let fit_gain = g.as_ref().map_or(0.0, |g| g.0);
+        let material = significant && (e.channel_material || fit_gain > 0.0);
+        if material && verdict.is_none() {
+            verdict = g.as_ref().map(|g| (i, g.1.clone()));
         }
         ranking.push(Ranked {
             effect: e.kind.name().into(),
             statistic: e.statistic,
             p_value: e.p,
+            above_noise: e.score,
             fit_gain_pp: fit_gain,
             significant,
             material,
@@ -951,16 +1107,28 @@ pub fn diagnose(
                 fmt_p(r.p_value),
                 r.fit_gain_pp
             );
-            if let Some(second) = ranking
+            if let Some((_, second)) = ranking
                 .iter()
                 .enumerate()
                 .find(|(j, x)| *j != i && x.significant)
             {
                 s.push_str(&format!(
-                    " Runner-up: {} (p {}).",
-                    second.1.effect,
-                    fmt_p(second.1.p_value)
+                    " Runner-up: {} (p {}, likelihood gain above noise {:.0} against {:.0}, \
+                     held-out fit gain {:+.1} pp).",
+                    second.effect,
+                    fmt_p(second.p_value),
+                    second.above_noise,
+                    r.above_noise,
+                    second.fit_gain_pp
                 ));
+                if second.p_value < r.p_value {
+                    s.push_str(
+                        " Effects are ranked by their likelihood gain above noise (the \
+                         statistic less its null mean), not by p: p-values this far in the \
+                         tail rest on the shape fitted to the null replicates and cannot be \
+                         compared between effects.",
+                    );
+                }
             }
             if let Some(a) = &aug {
                 s.push_str(&format!(" Refitted with the model: {}", a.explanation));
@@ -991,6 +1159,9 @@ pub fn diagnose(
         }
     };
     let mut explanation = explanation;
+    if let Some(g) = &gear {
+        explanation.push_str(&g.words);
+    }
     if !has_ref {
         explanation.push_str(
             " No reference records were given, so every statistic is judged against the \
@@ -1031,6 +1202,65 @@ pub fn diagnose(
     })
 }
 
+/// The actuator effects that are gear *dynamics*: a slow or delayed gear changes when the
+/// rudder/pod angle arrives, which a linear model absorbs into its poles (a lag), so with θ
+/// frozen the reference shows neither. An angle limit is static: θ cannot absorb it (it
+/// changes the gain at large angles, not the dynamics), so the frozen reference version
+/// already holds it — and on a hull whose turning rate grows less than linearly with the
+/// rudder angle a re-identified angle limit would stand for that hull physics instead.
+const GEAR_DYNAMICS: [EffectKind; 2] = [EffectKind::DeadTime, EffectKind::RateLimit];
+
+/// The actuator physics the reference records show of their own: the reference model with
+/// it, θ re-identified on the reference, and the explanation's sentence.
+#[derive(Debug, Clone)]
+struct RefActuator {
+    model: Model,
+    words: String,
+}
+
+/// The reference's own steering-gear physics (module docs): forward selection over the
+/// actuator effects the model lacks, on the reference records, by [`crate::augment`]'s rule
+/// (re-identified, kept only when the held-out part of the reference pays for it or the
+/// reference supports it decisively). `None` when it keeps none.
+fn reference_actuator(
+    model: &Model,
+    reference: &[Record],
+    cfg: &DiagnoseConfig,
+) -> Option<RefActuator> {
+    let kinds: Vec<EffectKind> = EffectKind::ALL
+        .iter()
+        .copied()
+        .filter(|k| GEAR_DYNAMICS.contains(k) && model.effect(*k).is_none())
+        .collect();
+    if kinds.is_empty() {
+        return None;
+    }
+    let f = crate::augment::forward(model, reference, &[], &kinds, &cfg.augment).ok()?;
+    if f.added.is_empty() || !f.model.is_stable() {
+        return None;
+    }
+    let own: Vec<String> = f
+        .added
+        .iter()
+        .filter_map(|k| f.model.effect(*k))
+        .map(|e| crate::augment::describe(e, model.ts))
+        .collect();
+    let words = format!(
+        " The reference records show steering-gear physics of their own that the linear \
+         model has absorbed into its poles: {} (re-identified on the reference, held-out \
+         10-step fit there {:.1} → {:.1} %). A gear the model only approximates looks like \
+         whatever actuator effect mimics it best on each record's commands, so every \
+         statistic is measured against the reference model with it.",
+        own.join(" and "),
+        f.before.get("10").copied().unwrap_or(f64::NAN),
+        f.after.get("10").copied().unwrap_or(f64::NAN),
+    );
+    Some(RefActuator {
+        model: f.model,
+        words,
+    })
+}
+
 /// Hold-out split: the last 30 % of each record (kept long enough for the slow horizon).
 fn split(est: &[Record]) -> (Vec<Record>, Vec<Record>) {
     let mut a = Vec::new();
@@ -1058,8 +1288,8 @@ fn describe(kind: EffectKind) -> &'static str {
         EffectKind::Bias => "a constant yaw moment",
         EffectKind::GyroBias => "a rate-gyro offset",
         EffectKind::DeadTime => "a command dead time",
-        EffectKind::RateLimit => "a pod slew-rate limit",
-        EffectKind::Saturation => "a pod angle limit",
+        EffectKind::RateLimit => "a rudder/pod slew-rate limit",
+        EffectKind::Saturation => "a rudder/pod angle limit",
         EffectKind::Asymmetry => "a port/starboard steering asymmetry",
         EffectKind::NonlinearDamping => "extra nonlinear yaw damping",
         EffectKind::Wind => "a heading-dependent wind moment",
@@ -1074,6 +1304,9 @@ struct WorldStat {
     d: f64,
     best: Effect,
     n: usize,
+    /// The version of the effect the reference shows (its best candidate with its gains, when
+    /// it beats the model there).
+    reference: Option<Effect>,
 }
 
 /// The statistic `D` of every kind in one world: the reference version of each effect is
@@ -1106,6 +1339,7 @@ fn world(
             d,
             best: effect_with(&cands[bi], &bb),
             n: tn,
+            reference: version.idx.map(|i| effect_with(&cands[i], &version.beta)),
         }
     };
     crate::par::map(grids, parallel, one)
@@ -1190,6 +1424,8 @@ fn effect_evidence(
         words: String::new(),
         parameter: None,
         channel_material: false,
+        reference: stat.reference,
+        speed_only: false,
     };
     let pct = 100.0 * (1.0 - (-d / tn.max(1) as f64).exp());
     match best {
@@ -1197,21 +1433,21 @@ fn effect_evidence(
             let s = samples as f64 * ts;
             ev.parameter = Some(s);
             ev.words = format!(
-                "errors follow the pod commands late; a dead time of {s:.1} s removes {pct:.0} % of \
+                "errors follow the steering commands late; a dead time of {s:.1} s removes {pct:.0} % of \
                  the one-step error energy the reference version leaves"
             );
         }
         Effect::RateLimit { rate } => {
             ev.parameter = Some(rate);
             ev.words = format!(
-                "errors grow right after fast pod reversals; a slew limit of {rate:.1} °/s explains \
+                "errors grow right after fast steering reversals; a slew limit of {rate:.1} °/s explains \
                  {pct:.0} % of the one-step error energy"
             );
         }
         Effect::Saturation { limit } => {
             ev.parameter = Some(limit);
             ev.words = format!(
-                "large pod angles turn the ship less than the model expects; an angle limit of \
+                "large rudder/pod angles turn the ship less than the model expects; an angle limit of \
                  {limit:.1}° explains {pct:.0} % of the one-step error energy"
             );
         }
@@ -1235,7 +1471,7 @@ fn effect_evidence(
         Effect::Bias { beta } => {
             ev.parameter = Some(beta);
             ev.words = format!(
-                "a steady yaw moment worth {beta:+.2}° of pod angle; explains {pct:.0} % of the \
+                "a steady yaw moment worth {beta:+.2}° of rudder/pod angle; explains {pct:.0} % of the \
                  {SLOW_HORIZON}-step error energy"
             );
         }
@@ -1247,14 +1483,16 @@ fn effect_evidence(
         }
         Effect::Wind { .. } => {
             ev.words = format!(
-                "the yaw moment varies with heading (1st and 2nd harmonics); explains {pct:.0} % \
-                 of the {SLOW_HORIZON}-step error energy"
+                "a yaw moment with the heading's 1st and 2nd harmonics takes {pct:.0} % of the \
+                 {SLOW_HORIZON}-step error energy (yaw channel: p {})",
+                fmt_p(p_yaw)
             );
         }
         Effect::Current { .. } => {
             ev.words = format!(
-                "the yaw moment varies with heading (1st harmonic); explains {pct:.0} % of the \
-                 {SLOW_HORIZON}-step error energy"
+                "a yaw moment with the heading's 1st harmonic takes {pct:.0} % of the \
+                 {SLOW_HORIZON}-step error energy (yaw channel: p {})",
+                fmt_p(p_yaw)
             );
         }
     }
@@ -1312,6 +1550,44 @@ fn effect_evidence(
     ev
 }
 
+/// An effect named from speed over ground alone — current or wind while the yaw channel
+/// shows no heading-dependent moment ([`Evidence::speed_only`]) — that buys no held-out
+/// yaw-rate prediction is not named ahead of a significant effect that does: it explains
+/// none of the yaw-rate departures the other one explains, and a yaw-rate predictor is what
+/// the model is. The first such effect behind it moves ahead of it (`gains[i]`: held-out
+/// gain and fits of the significant effects, in the order of `ev`).
+fn yaw_before_speed(ev: &mut Vec<Evidence>, gains: &mut Vec<Option<(f64, BTreeMap<String, f64>)>>) {
+    let gain = |g: &Option<(f64, BTreeMap<String, f64>)>| g.as_ref().map(|g| g.0);
+    let material = |e: &Evidence, g: &Option<(f64, BTreeMap<String, f64>)>| {
+        g.is_some() && (e.channel_material || gain(g).is_some_and(|v| v > 0.0))
+    };
+    let Some(i) = (0..ev.len()).find(|&i| material(&ev[i], &gains[i])) else {
+        return;
+    };
+    let gi = gain(&gains[i]).unwrap_or(0.0);
+    if !ev[i].speed_only || gi > 0.0 {
+        return;
+    }
+    let Some(j) =
+        (i + 1..ev.len()).find(|&j| !ev[j].speed_only && gain(&gains[j]).is_some_and(|v| v > 0.0))
+    else {
+        return;
+    };
+    let gj = gain(&gains[j]).unwrap_or(0.0);
+    let words = format!(
+        "; named behind {}: only speed over ground shows it (the yaw channel shows no \
+         heading-dependent moment) and it buys no held-out yaw-rate prediction ({gi:+.1} pp), \
+         where {} is significant in the yaw rate and buys {gj:+.1} pp",
+        ev[j].kind.name(),
+        ev[j].kind.name(),
+    );
+    ev[i].words.push_str(&words);
+    let e = ev.remove(j);
+    ev.insert(i, e);
+    let g = gains.remove(j);
+    gains.insert(i, g);
+}
+
 /// Current or wind, when speed over ground is logged (module docs): a uniform current carries
 /// the ship without a heading-dependent yaw moment, wind turns it. "Wind" nests "current"
 /// (the speed harmonics are free in both; wind adds the yaw-moment harmonics), so the
@@ -1344,6 +1620,8 @@ fn current_or_wind(ev: &mut Vec<Evidence>, level: f64, alpha: f64, speed: bool) 
     );
     ev[ic].words.push_str(&words);
     ev[iw].words.push_str(&words);
+    ev[ic].speed_only = !wind;
+    ev[iw].speed_only = !wind;
     if wind {
         let heading_p = ev[ic].p.min(ev[iw].p);
         let cm = ev[ic].channel_material;
@@ -1358,14 +1636,19 @@ fn current_or_wind(ev: &mut Vec<Evidence>, level: f64, alpha: f64, speed: bool) 
     }
 }
 
-/// Encompassing test between the top two significant effects of the same horizon class:
-/// both fitted jointly; what does each add given the other? The one that adds nothing
-/// significant given the other is explained by it (and, when neither adds anything, the
-/// simpler one is kept). An effect shown by its own channel is not displaced by one that is not.
+/// Encompassing test between the top two significant effects: both fitted jointly, each
+/// over its whole grid (a dead time and a slew limit that mimic each other alone settle on
+/// other values together); what does each add, given the other, beyond the version the
+/// reference shows? `adds_a = N·ln(SSE(a at its reference version, b free)/SSE(both free))`,
+/// judged against a's own bootstrap null. The one that adds nothing significant given the
+/// other is explained by it (and, when neither adds anything, the simpler one is kept). An
+/// effect shown by its own channel is not displaced by one that is not.
+#[allow(clippy::too_many_arguments)]
 fn encompass(
     model: &Model,
     trial: &Set<'_>,
     ev: &mut [Evidence],
+    grids: &[(EffectKind, Vec<Effect>)],
     level: f64,
     alpha: f64,
     par: bool,
@@ -1385,22 +1668,36 @@ fn encompass(
     // on the slower horizon every effect is visible; the scale of the null comes from an
     // effect judged on that horizon
     let h = ev[0].h.max(ev[1].h);
-    let alone = |x: &Evidence| {
-        trial.family(model, &[zero_gains(&x.best)], h, par)[0]
-            .best()
-            .1
-    };
-    let on_top = |base: &Evidence, x: &Evidence| {
-        let m = model.clone().with_effect(base.best);
-        trial.family(&m, &[zero_gains(&x.best)], h, par)[0].best().1
+    let cands = |x: &Evidence| -> Vec<Effect> {
+        grids
+            .iter()
+            .find(|(k, _)| *k == x.kind)
+            .map_or_else(|| vec![zero_gains(&x.best)], |(_, g)| g.clone())
     };
     let (a, b) = (&ev[0], &ev[1]);
-    let sa = alone(a);
-    let sb = alone(b);
-    let sab = on_top(a, b).min(on_top(b, a)).min(sa).min(sb);
+    let (ca, cb) = (cands(a), cands(b));
+    let best_sse = |q: &[Quad]| q.iter().map(|q| q.best().1).fold(f64::INFINITY, f64::min);
+    // one effect held at the version the reference shows (the model itself when it shows
+    // none), the other over its grid
+    let held = |x: &Evidence, other: &[Effect]| {
+        let m = match x.reference {
+            Some(r) => model.clone().with_effect(r),
+            None => model.clone(),
+        };
+        best_sse(&trial.family(&m, other, h, par))
+    };
+    let sa_ref = held(a, &cb);
+    let sb_ref = held(b, &ca);
+    let product: Vec<(Effect, Effect)> = ca
+        .iter()
+        .flat_map(|x| cb.iter().map(move |y| (*x, *y)))
+        .collect();
+    let sab = best_sse(&trial.pairs(model, &product, h, par))
+        .min(sa_ref)
+        .min(sb_ref);
     let n = trial.sse0(model, h).1 as f64;
-    let adds_a = (n * (sb / sab).ln()).max(0.0);
-    let adds_b = (n * (sa / sab).ln()).max(0.0);
+    let adds_a = (n * (sa_ref / sab).ln()).max(0.0);
+    let adds_b = (n * (sb_ref / sab).ln()).max(0.0);
     let scale = |x: &Evidence| {
         if x.h == h {
             x.null
@@ -1439,13 +1736,19 @@ fn encompass(
         (false, false) => simpler_b,
         (true, false) => false,
     };
+    let adds = |x: &str, y: &str, p: f64| {
+        if p < alpha {
+            format!("given {y}, {x} still adds (p {})", fmt_p(p))
+        } else {
+            format!("given {y}, {x} adds nothing significant (p {})", fmt_p(p))
+        }
+    };
+    let (na, nb) = (a.kind.name(), b.kind.name());
     let w = format!(
-        "; encompassing test ({h}-step errors): given {nb}, {na} still adds (p {}); given \
-         {na}, {nb} adds (p {})",
-        fmt_p(pa),
-        fmt_p(pb),
-        na = a.kind.name(),
-        nb = b.kind.name()
+        "; encompassing test ({h}-step errors, both fitted together, each measured from the \
+         version the reference shows): {}; {}",
+        adds(na, nb, pa),
+        adds(nb, na, pb),
     );
     ev[0].words.push_str(&w);
     ev[1].words.push_str(&w);
@@ -1685,6 +1988,30 @@ mod tests {
     }
 
     #[test]
+    fn speed_lost_in_turns_is_not_a_current() {
+        // a slew limit changes the turning history, and with it the heading history, against
+        // the reference's: with one 20 s lag the speed lost in turns that the nuisance
+        // regressors leave aliases onto the heading harmonics and passes for a current
+        // (p < 1e-3 at 2 df, significant at α/9); the bank of surge lags takes it out
+        let reference = records(None, &[300, 301]);
+        let trial = records(Some((EffectKind::RateLimit, 1.0)), &[302, 303]);
+        let one = sog_evidence_with(&trial, &reference, 1, &[20.0]).unwrap();
+        assert!(one.chi1 > 13.8 && one.amp1 > 0.02, "{one:?}");
+        let bank = sog_evidence(&trial, &reference, 1).unwrap();
+        assert!(bank.chi1 < 9.21 && bank.amp1 < 0.01, "{bank:?}");
+        // no hidden effect at all: the same
+        let none = records(None, &[302, 303]);
+        let one = sog_evidence_with(&none, &reference, 1, &[20.0]).unwrap();
+        assert!(one.chi1 > 13.8, "{one:?}");
+        let bank = sog_evidence(&none, &reference, 1).unwrap();
+        assert!(bank.chi1 < 9.21 && bank.amp1 < 0.01, "{bank:?}");
+        assert_eq!(
+            sog_taus(reference.iter().chain(&trial)),
+            vec![10.0, 30.0, 90.0, 270.0]
+        );
+    }
+
+    #[test]
     fn frozen_statistic_finds_a_known_dead_time() {
         // innovations data of a known model whose commands arrive 3 samples late
         let truth = crate::pem::testdata::truth();
@@ -1853,6 +2180,126 @@ mod tests {
             words: String::new(),
             parameter: None,
             channel_material,
+            reference: None,
+            speed_only: false,
+        }
+    }
+
+    /// The built-in ship with a slow steering gear (4 °/s, servo lag 2.5 s, as on many large
+    /// ships): records with one hidden effect, or none.
+    fn slow_gear_records(kind: Option<EffectKind>, seeds: &[u64]) -> Vec<Record> {
+        let mut ship = Ship::default_lng();
+        ship.actuator.slew_degps = 4.0;
+        ship.actuator.servo_tau_s = 2.5;
+        let mut sc = match kind {
+            Some(k) => Scenario::with_effect(SimEffect::hidden(k, 1.0)),
+            None => Scenario::default(),
+        };
+        sc.noise = noise();
+        seeds
+            .par_iter()
+            .map(|&s| simulate(&ship, &sc, s).unwrap())
+            .collect()
+    }
+
+    #[test]
+    fn dead_time_on_a_rate_limited_reference_gear_is_named_dead_time() {
+        // the linear reference model absorbs the gear's slew limit into its poles; with θ
+        // frozen a slew limit then mimics the trials' extra 2 s delay as well as the delay
+        // itself. Measured against the reference model with its own gear, the delay stands out.
+        let reference = slow_gear_records(None, &[500, 501]);
+        let model = identify(&reference);
+        let cfg = DiagnoseConfig {
+            confirm: false,
+            ..DiagnoseConfig::default()
+        };
+        let est = slow_gear_records(Some(EffectKind::DeadTime), &[502, 503]);
+        let d = diagnose(&model, &reference, &est, &[], &cfg).unwrap();
+        assert_eq!(
+            d.verdict_kind(),
+            Some(EffectKind::DeadTime),
+            "{}",
+            d.explanation
+        );
+        let dt = &d.ranking[0];
+        assert_eq!(dt.parameter, Some(2.0), "{dt:?}");
+        assert!(dt.fit_gain_pp > 10.0, "{dt:?}");
+        // the reference's own gear, found with θ re-identified (4 °/s and a 2.5 s lag)
+        let own = d.explanation.find("slew limit of ").unwrap() + "slew limit of ".len();
+        let rate: f64 = d.explanation[own..]
+            .split(' ')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!((3.5..6.0).contains(&rate), "{}", d.explanation);
+        // the encompassing test in words that say what they mean
+        assert!(
+            dt.evidence
+                .contains("given dead-time, rate-limit adds nothing significant"),
+            "{}",
+            dt.evidence
+        );
+        assert!(
+            dt.evidence
+                .contains("given rate-limit, dead-time still adds"),
+            "{}",
+            dt.evidence
+        );
+        let rl = d.ranking.iter().find(|r| r.effect == "rate-limit").unwrap();
+        assert!(rl.above_noise < dt.above_noise, "{rl:?}");
+        assert!(
+            d.explanation.contains("likelihood gain above noise"),
+            "{}",
+            d.explanation
+        );
+        // no hidden effect on the same gear: nothing, in particular no slew limit
+        let none = slow_gear_records(None, &[502, 503]);
+        let d = diagnose(&model, &reference, &none, &[], &cfg).unwrap();
+        assert_eq!(d.verdict, "none", "{}", d.explanation);
+        assert!(d.ranking.iter().all(|r| !r.significant), "{:?}", d.ranking);
+    }
+
+    #[test]
+    fn speed_over_ground_alone_is_not_named_ahead_of_a_yaw_effect() {
+        let level = 0.01 / 9.0;
+        let mut cur = evidence(EffectKind::Current, 9e-4, 1.0, true);
+        cur.speed_only = true;
+        let mut ev = vec![
+            cur,
+            evidence(EffectKind::Wind, 2e-4, 1.0, true),
+            evidence(EffectKind::RateLimit, 0.0, 0.0, false),
+        ];
+        ev[1].speed_only = true;
+        let fits = BTreeMap::new();
+        let mut gains = vec![
+            Some((-1.6, fits.clone())),
+            Some((-1.7, fits.clone())),
+            Some((23.7, fits.clone())),
+        ];
+        assert!(ev.iter().all(|e| e.p < level));
+        yaw_before_speed(&mut ev, &mut gains);
+        let kinds: Vec<EffectKind> = ev.iter().map(|e| e.kind).collect();
+        assert_eq!(
+            kinds,
+            [EffectKind::RateLimit, EffectKind::Current, EffectKind::Wind]
+        );
+        assert_eq!(gains[0].as_ref().unwrap().0, 23.7);
+        assert!(
+            ev[1].words.contains("named behind rate-limit"),
+            "{}",
+            ev[1].words
+        );
+        // a current whose yaw moment is seen, or that buys yaw-rate prediction, stays first
+        for (speed_only, gain) in [(false, -1.6), (true, 0.4)] {
+            let mut ev = vec![
+                evidence(EffectKind::Current, 9e-4, 1.0, true),
+                evidence(EffectKind::RateLimit, 0.0, 0.0, false),
+            ];
+            ev[0].speed_only = speed_only;
+            let mut gains = vec![Some((gain, fits.clone())), Some((23.7, fits.clone()))];
+            yaw_before_speed(&mut ev, &mut gains);
+            assert_eq!(ev[0].kind, EffectKind::Current);
         }
     }
 

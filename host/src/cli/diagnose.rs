@@ -131,16 +131,22 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
 }
 
 fn print_report(d: &Diagnosis) {
+    // ranked by the likelihood gain above noise; far-tail p-values are not compared
     println!(
-        "{:<18} {:>12} {:>10} {:>9} {:>4} {:>4} {:>10}",
-        "effect", "statistic", "p", "gain pp", "sig", "mat", "parameter"
+        "{:<18} {:>12} {:>12} {:>10} {:>9} {:>4} {:>4} {:>10}",
+        "effect", "statistic", "above noise", "p", "gain pp", "sig", "mat", "parameter"
     );
     for r in &d.ranking {
         println!(
-            "{:<18} {:>12.1} {:>10.2e} {:>9.2} {:>4} {:>4} {:>10}",
+            "{:<18} {:>12.1} {:>12.1} {:>10} {:>9.2} {:>4} {:>4} {:>10}",
             r.effect,
             r.statistic,
-            r.p_value,
+            r.above_noise,
+            if r.p_value < 1e-16 {
+                "<1e-16".to_string()
+            } else {
+                format!("{:.2e}", r.p_value)
+            },
             r.fit_gain_pp,
             if r.significant { "yes" } else { "no" },
             if r.material { "yes" } else { "no" },
