@@ -169,6 +169,11 @@ pub struct Diagnosis {
     pub before: BTreeMap<String, f64>,
     /// Held-out fit % of the model with the verdict's effect (same as `before` when `none`).
     pub after: BTreeMap<String, f64>,
+    /// The reference model with the steering-gear dynamics the reference records show of
+    /// their own (θ re-identified on them), when they show some: what the statistics were
+    /// measured against, and the better start for augmenting.
+    #[serde(skip)]
+    pub reference_gear: Option<Model>,
 }
 
 impl Diagnosis {
@@ -180,6 +185,7 @@ impl Diagnosis {
     /// let d = Diagnosis {
     ///     verdict: "dead-time".into(), ranking: vec![], explanation: String::new(),
     ///     reference_used: true, augment: None, before: Default::default(), after: Default::default(),
+    ///     reference_gear: None,
     /// };
     /// assert_eq!(d.verdict_kind(), Some(EffectKind::DeadTime));
     /// ```
@@ -1199,6 +1205,7 @@ pub fn diagnose(
         augment,
         before,
         after,
+        reference_gear: gear.map(|g| g.model),
     })
 }
 

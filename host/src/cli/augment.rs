@@ -43,6 +43,9 @@ pub struct AugmentArgs {
     /// Reference records the model was identified from (the simulator's), for `--effect auto`.
     #[arg(long, value_name = "FILE")]
     pub reference: Vec<PathBuf>,
+    /// Bootstrap replicates per effect of the diagnosis `--effect auto` runs (as `diagnose`).
+    #[arg(long, value_name = "N", default_value_t = super::common::NULL_REPS)]
+    pub null_reps: usize,
     /// Where the augmented model goes: `<PATH>.postcard` and its `<PATH>.json` twin (the
     /// input model unchanged when the effect is not kept).
     #[arg(long, value_name = "PATH")]
@@ -232,10 +235,29 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
     let val = read_checked(&args.read, &args.validate, &model)?;
     let reference = read_checked(&args.read, &args.reference, &model)?;
     let seed = args.seed.resolve();
-    let (kind, auto) = match wanted {
-        Wanted::Named(k) => (Some(k), false),
-        Wanted::Nothing => (None, false),
-        Wanted::Auto => (choose_auto(&model, &reference, &est, &val, seed)?, true),
+    let (kind, auto, model) = match wanted {
+        Wanted::Named(k) => (Some(k), false, model),
+        Wanted::Nothing => (None, false, model),
+        Wanted::Auto => {
+            let (kind, gear) = choose_auto(&model, &reference, &est, &val, seed, args.null_reps)?;
+            // the reference's own steering gear, found by diagnose, is part of the reference
+            let model = match gear {
+                Some(g) => {
+                    println!(
+                        "augmenting the reference model with the steering-gear dynamics the \
+                         reference records show of their own: {}",
+                        g.effects
+                            .iter()
+                            .map(|e| augment::describe(e, g.ts))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    );
+                    g
+                }
+                None => model,
+            };
+            (kind, true, model)
+        }
     };
     let cfg = AugmentConfig::default();
     let Some(kind) = kind else {
@@ -443,23 +465,26 @@ fn describe_written(w: Written) -> &'static str {
     }
 }
 
-/// `--effect auto`: the verdict of `diagnose` (`None` for `none`), printed with its reasons.
+/// `--effect auto`: the verdict of `diagnose` (`None` for `none`), printed with its reasons,
+/// and the reference model with its own steering gear when diagnose found one.
 fn choose_auto(
     model: &Model,
     reference: &[Record],
     est: &[Record],
     val: &[Record],
     seed: u64,
-) -> Result<Option<EffectKind>> {
+    null_reps: usize,
+) -> Result<(Option<EffectKind>, Option<Model>)> {
     let cfg = yawcast::diagnose::DiagnoseConfig {
         seed,
+        null_reps,
         // the refit below confirms the verdict
         confirm: false,
         ..Default::default()
     };
     let d = yawcast::diagnose::diagnose(model, reference, est, val, &cfg).map_err(bad)?;
     println!("diagnose: verdict {}: {}", d.verdict, d.explanation);
-    Ok(d.verdict_kind())
+    Ok((d.verdict_kind(), d.reference_gear))
 }
 
 /// Reads (or creates from the built-in ship) the ship file, adds the effect in physical

@@ -206,6 +206,10 @@ impl ReadArgs {
     }
 }
 
+/// Bootstrap replicates per effect of `diagnose`, and of the diagnosis `augment --effect
+/// auto` runs: one default, so the two commands reach the same verdict on the same records.
+pub const NULL_REPS: usize = 40;
+
 /// `--json FILE`: where the machine-readable summary goes.
 #[derive(Debug, Clone, Args)]
 pub struct JsonArg {

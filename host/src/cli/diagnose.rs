@@ -32,7 +32,7 @@ pub struct DiagnoseArgs {
     #[arg(long, value_name = "FILE")]
     pub validate: Vec<PathBuf>,
     /// Bootstrap replicates per effect for the null distributions.
-    #[arg(long, value_name = "N", default_value_t = 40)]
+    #[arg(long, value_name = "N", default_value_t = super::common::NULL_REPS)]
     pub null_reps: usize,
     /// Significance level.
     #[arg(long, value_name = "P", default_value_t = 0.01)]
