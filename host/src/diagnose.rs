@@ -1188,7 +1188,9 @@ pub fn diagnose(
     if !heading_ok {
         explanation.push_str(
             " Heading is not logged in every record: a gyro bias cannot be told apart from a \
-             constant yaw moment (bias).",
+             constant yaw moment (bias), and wind and current are tested on the heading \
+             integrated from the measured yaw rate, from an unknown start (0°) and drifting \
+             with any rate offset.",
         );
     }
     if !speed_ok {
