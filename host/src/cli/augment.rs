@@ -73,9 +73,11 @@ pub struct AugmentSummary {
     pub auto: bool,
     /// Whether it was kept.
     pub kept: bool,
-    /// What the model written is: `"augmented"` (effects added), `"refit"` (no effect added;
-    /// the input structure re-identified on the estimation records validates better than the
-    /// input model) or `"input"` (the input model unchanged).
+    /// What the model written is, against the model given: `"augmented"` (it carries effects
+    /// that one lacks: the kept effect, those `--more` added, or the reference's own steering
+    /// gear that `--effect auto` found), `"refit"` (no effect added; the structure
+    /// re-identified on the estimation records validates better) or `"input"` (the model
+    /// given, unchanged).
     pub written: Written,
     /// The input model on the held-out records.
     pub before: FitSummary,
@@ -230,45 +232,33 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
             twin.display()
         )));
     }
-    let model = read_model(&args.model)?;
-    let est = read_checked(&args.read, &args.data, &model)?;
-    let val = read_checked(&args.read, &args.validate, &model)?;
-    let reference = read_checked(&args.read, &args.reference, &model)?;
+    let given = read_model(&args.model)?;
+    let est = read_checked(&args.read, &args.data, &given)?;
+    let val = read_checked(&args.read, &args.validate, &given)?;
+    let reference = read_checked(&args.read, &args.reference, &given)?;
     let seed = args.seed.resolve();
     let (kind, auto, model) = match wanted {
-        Wanted::Named(k) => (Some(k), false, model),
-        Wanted::Nothing => (None, false, model),
+        Wanted::Named(k) => (Some(k), false, given.clone()),
+        Wanted::Nothing => (None, false, given.clone()),
         Wanted::Auto => {
-            let (kind, gear) = choose_auto(&model, &reference, &est, &val, seed, args.null_reps)?;
-            // the reference's own steering gear, found by diagnose, is part of the reference
+            let (kind, gear) = choose_auto(&given, &reference, &est, &val, seed, args.null_reps)?;
             let model = match gear {
-                Some(g) => {
-                    println!(
-                        "augmenting the reference model with the steering-gear dynamics the \
-                         reference records show of their own: {}",
-                        g.effects
-                            .iter()
-                            .map(|e| augment::describe(e, g.ts))
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    );
-                    g
-                }
-                None => model,
+                Some(g) => with_reference_gear(&given, g, kind),
+                None => given.clone(),
             };
             (kind, true, model)
         }
     };
     let cfg = AugmentConfig::default();
     let Some(kind) = kind else {
-        return write_unchanged(args, &model, &est, &val, auto, &cfg);
+        return write_unchanged(args, &given, &model, &est, &val, auto, &cfg);
     };
     let t0 = std::time::Instant::now();
     let rep = augment::augment(&model, kind, &est, &val, &cfg).map_err(cli_err)?;
     print_report(&rep, t0.elapsed().as_secs_f64());
     let more = search_more(args, &rep.model, &est, &val, &cfg)?;
     let written = more.as_ref().map_or(&rep.model, |f| &f.model);
-    let what = written_kind(rep.kept, rep.written, more.as_ref());
+    let what = written_kind(&given, written);
 
     let check = val
         .first()
@@ -380,8 +370,10 @@ fn search_more(
 
 /// No named effect (`--effect auto` with the verdict `none`, or `--effect none`): the input
 /// model, or with `--more` the result of the search from it, is written.
+#[allow(clippy::too_many_arguments)]
 fn write_unchanged(
     args: &AugmentArgs,
+    given: &Model,
     model: &Model,
     est: &[Record],
     val: &[Record],
@@ -390,7 +382,7 @@ fn write_unchanged(
 ) -> Result<()> {
     let more = search_more(args, model, est, val, cfg)?;
     let written = more.as_ref().map_or(model, |f| &f.model);
-    let what = written_kind(false, Written::Input, more.as_ref());
+    let what = written_kind(given, written);
     let check = val
         .first()
         .or(est.first())
@@ -416,10 +408,15 @@ fn write_unchanged(
             p.display()
         );
     }
-    let explanation = if auto {
-        "diagnose found no missing effect; the model is kept as it is"
-    } else {
-        "no effect named"
+    let searched = more.as_ref().is_some_and(|f| !f.added.is_empty());
+    let explanation = match (auto, what) {
+        (true, Written::Augmented) if !searched => {
+            "diagnose found no missing effect; the model written is the reference model with \
+             the steering-gear dynamics the reference records show of their own"
+        }
+        (true, Written::Input) => "diagnose found no missing effect; the model is kept as it is",
+        (true, _) => "diagnose found no missing effect",
+        (false, _) => "no effect named",
     };
     args.json.write(&serde_json::json!({
         "command": "augment",
@@ -440,17 +437,48 @@ fn write_unchanged(
     }))
 }
 
-/// What the written model is, from the named effect's decision (`kept`, `written`) and the
-/// `--more` search that started from its model.
-fn written_kind(kept: bool, written: Written, more: Option<&augment::ForwardReport>) -> Written {
-    let added = more.is_some_and(|f| !f.added.is_empty());
-    if kept || added {
-        Written::Augmented
-    } else if written == Written::Refit || more.is_some_and(|f| f.written == Written::Refit) {
-        Written::Refit
-    } else {
+/// What the written model is against the model the user gave: `Augmented` when it carries
+/// an effect that one lacks (or the same effect with another value), `Input` when it is that
+/// model, else `Refit` (the same structure, re-identified).
+fn written_kind(given: &Model, written: &Model) -> Written {
+    if written == given {
         Written::Input
+    } else if written
+        .effects
+        .iter()
+        .any(|e| given.effect(e.kind()) != Some(e))
+    {
+        Written::Augmented
+    } else {
+        Written::Refit
     }
+}
+
+/// `--effect auto` found steering-gear dynamics the reference records show of their own
+/// (`gear`: the reference model with them, re-identified on the reference): they are part of
+/// the reference, so the trials are augmented from that model. When the verdict is of the
+/// same kind (a slower slew limit on the trials than the reference's own), the trials'
+/// value is estimated from the model given, as without a gear.
+fn with_reference_gear(given: &Model, gear: Model, verdict: Option<EffectKind>) -> Model {
+    if verdict.is_some_and(|k| gear.effect(k).is_some()) {
+        return given.clone();
+    }
+    let m = gear;
+    let own: Vec<String> = m
+        .effects
+        .iter()
+        .filter(|e| given.effect(e.kind()).is_none())
+        .map(|e| augment::describe(e, m.ts))
+        .collect();
+    if own.is_empty() {
+        return given.clone();
+    }
+    println!(
+        "augmenting the reference model with the steering-gear dynamics the reference records \
+         show of their own: {}",
+        own.join(", ")
+    );
+    m
 }
 
 /// The note after "model written to …".
