@@ -841,6 +841,92 @@ fn sim_csvs(
 }
 
 #[test]
+fn augment_auto_on_a_slow_gear_reference_names_and_keeps_a_slower_slew_limit() {
+    // the reference ship's own gear slews at 4 °/s behind a 2.5 s servo lag, which its linear
+    // model absorbs; diagnose finds that gear on the reference, and the trials' slower gear
+    // (the library's slew-limit effect) is named and kept from the model given — the gear
+    // model already has a slew limit, so it is not the start (this exited 2 before)
+    use yawcast::sim::{simulate, Scenario, Ship, SimEffect};
+    use yawcast_shared::model::EffectKind;
+    let d = scratch("slowgear");
+    let mut ship = Ship::default_lng();
+    ship.actuator.slew_degps = 4.0;
+    ship.actuator.servo_tau_s = 2.5;
+    let write = |name: &str, effect: Option<SimEffect>, seeds: &[u64]| -> Vec<PathBuf> {
+        let sc = Scenario {
+            effects: effect.into_iter().collect(),
+            ..Scenario::default()
+        };
+        seeds
+            .iter()
+            .map(|&seed| {
+                let rec = simulate(&ship, &sc, seed).unwrap();
+                let p = d.join(format!("{name}-{seed}.csv"));
+                yawcast::data::write_csv(&p, &rec).unwrap();
+                p
+            })
+            .collect()
+    };
+    let reference = write("ref", None, &[501, 502]);
+    let recs: Vec<_> = reference
+        .iter()
+        .map(|p| yawcast::data::read_csv(p).unwrap())
+        .collect();
+    let base = yawcast::pem::identify(&recs, None, &Default::default())
+        .unwrap()
+        .model;
+    let model = d.join("base.json");
+    std::fs::write(&model, serde_json::to_string(&base).unwrap()).unwrap();
+    let slower = SimEffect::hidden(EffectKind::RateLimit, 1.0);
+    let est = write("trial", Some(slower), &[1, 2]);
+    let val = write("check", Some(slower), &[11]);
+    let s = |p: &Path| p.display().to_string();
+    let (out, json) = (d.join("aug.postcard"), d.join("aug-summary.json"));
+    let o = run(&[
+        "augment",
+        "--model",
+        &s(&model),
+        "--effect",
+        "auto",
+        "--reference",
+        &s(&reference[0]),
+        "--reference",
+        &s(&reference[1]),
+        "--data",
+        &s(&est[0]),
+        "--data",
+        &s(&est[1]),
+        "--validate",
+        &s(&val[0]),
+        "--out",
+        &s(&out),
+        "--json",
+        &s(&json),
+        "--seed",
+        "1",
+    ]);
+    assert_eq!(code(&o), 0, "{}\n{}", stdout(&o), stderr(&o));
+    // diagnose saw the reference's own gear (the case that made augment refuse its model)
+    assert!(
+        stdout(&o).contains("steering-gear physics of their own"),
+        "{}",
+        stdout(&o)
+    );
+    assert!(!stdout(&o).contains("augmenting the reference model"));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["effect"], "rate-limit", "{}", stdout(&o));
+    assert_eq!(v["kept"], true, "{}", v["explanation"]);
+    assert_eq!(v["written"], "augmented");
+    assert_eq!(v["effects"], serde_json::json!(["rate-limit"]));
+    let (b10, a10) = (
+        v["before"]["fit"]["10"].as_f64().unwrap(),
+        v["after"]["fit"]["10"].as_f64().unwrap(),
+    );
+    assert!(a10 > b10 + 2.0, "{b10} → {a10}");
+}
+
+#[test]
 fn augment_adds_a_dead_time_exports_it_and_writes_the_ship() {
     use yawcast::sim::SimEffect;
     use yawcast_shared::model::EffectKind;
