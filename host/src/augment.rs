@@ -772,8 +772,8 @@ fn without_effect(
     }
     let note = format!(
         "The model written is the input structure re-identified on the estimation records: \
-         it validates better than the input model on the held-out records (10 steps {i10:.1} \
-         → {b10:.1} %, simulation {isim:.1} → {bsim:.1} %)."
+         it validates better than the input model on the held-out records (10 steps {i10:.2} \
+         → {b10:.2} %, simulation {isim:.2} → {bsim:.2} %)."
     );
     (refit, Written::Refit, Some(note))
 }

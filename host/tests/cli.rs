@@ -584,6 +584,37 @@ fn identify_average_export_compare_chain() {
         &p("t0.csv"),
     ]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let fits_now = stdout(&o);
+
+    // A blob of an older format (version bytes 4..6) is read from its JSON twin with a
+    // warning, to the same fits; without the twin it is a clear error naming both files.
+    let mut old = std::fs::read(d.join("ctl/model.postcard")).unwrap();
+    old[4..6].copy_from_slice(&1u16.to_le_bytes());
+    std::fs::write(d.join("ctl/model.postcard"), &old).unwrap();
+    let o = run(&[
+        "compare",
+        "--model",
+        &p("ctl/model.postcard"),
+        "--data",
+        &p("t0.csv"),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(stderr(&o).contains("format 1 is older"), "{}", stderr(&o));
+    assert_eq!(stdout(&o), fits_now);
+    std::fs::remove_file(d.join("ctl/model.json")).unwrap();
+    let o = run(&[
+        "compare",
+        "--model",
+        &p("ctl/model.postcard"),
+        "--data",
+        &p("t0.csv"),
+    ]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("model.postcard") && stderr(&o).contains("model.json"),
+        "{}",
+        stderr(&o)
+    );
 
     // Bad input: --json on the model's own twin, an order range outside 2..=8, a constant input.
     let o = run(&[

@@ -46,8 +46,9 @@ pub struct AugmentArgs {
     /// Bootstrap replicates per effect of the diagnosis `--effect auto` runs (as `diagnose`).
     #[arg(long, value_name = "N", default_value_t = super::common::NULL_REPS)]
     pub null_reps: usize,
-    /// Where the augmented model goes: `<PATH>.postcard` and its `<PATH>.json` twin (the
-    /// input model unchanged when the effect is not kept).
+    /// Where the augmented model goes: `<PATH>.postcard` and its `<PATH>.json` twin. When
+    /// the effect is not kept: the model re-identified on the records when it validates
+    /// better than the input model, else the input model unchanged (`written` in the JSON).
     #[arg(long, value_name = "PATH")]
     pub out: PathBuf,
     /// Also write the effect, in physical units, into this ship file (created from the
@@ -243,7 +244,9 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
         Wanted::Auto => {
             let (kind, gear) = choose_auto(&given, &reference, &est, &val, seed, args.null_reps)?;
             let model = match gear {
-                Some(g) => with_reference_gear(&given, g, kind),
+                Some(g) => {
+                    with_reference_gear(&given, g, kind, if val.is_empty() { &est } else { &val })
+                }
                 None => given.clone(),
             };
             (kind, true, model)
@@ -456,11 +459,31 @@ fn written_kind(given: &Model, written: &Model) -> Written {
 
 /// `--effect auto` found steering-gear dynamics the reference records show of their own
 /// (`gear`: the reference model with them, re-identified on the reference): they are part of
-/// the reference, so the trials are augmented from that model. When the verdict is of the
-/// same kind (a slower slew limit on the trials than the reference's own), the trials'
+/// the reference, so the trials are augmented from that model — when it predicts the trial
+/// records `check` at 10 steps at least as well as the model given. When the verdict is of
+/// the same kind (a slower slew limit on the trials than the reference's own), the trials'
 /// value is estimated from the model given, as without a gear.
-fn with_reference_gear(given: &Model, gear: Model, verdict: Option<EffectKind>) -> Model {
+fn with_reference_gear(
+    given: &Model,
+    gear: Model,
+    verdict: Option<EffectKind>,
+    check: &[Record],
+) -> Model {
     if verdict.is_some_and(|k| gear.effect(k).is_some()) {
+        return given.clone();
+    }
+    let fit10 = |m: &Model| {
+        yawcast::merge::validation_fits(m, check)
+            .get("10")
+            .copied()
+            .unwrap_or(f64::NAN)
+    };
+    let (fg, fm) = (fit10(&gear), fit10(given));
+    if fg.is_nan() || fg < fm {
+        println!(
+            "the reference's own steering gear is left out: the reference model with it \
+             predicts the trials worse at 10 steps ({fg:.2} < {fm:.2} %)"
+        );
         return given.clone();
     }
     let m = gear;

@@ -9,6 +9,7 @@ use serde::Serialize;
 use yawcast::data::{self, Columns, Record};
 use yawcast::model::Model;
 use yawcast::nmea::{self, Clock, NmeaOptions};
+use yawcast_shared::blob::FORMAT_VERSION;
 
 /// Marks an error as caused by the user's input (exit code 2).
 #[derive(Debug, thiserror::Error)]
@@ -283,10 +284,31 @@ pub fn read_model(path: &Path) -> Result<Model> {
     if is_json {
         return model_from_json(&bytes, path);
     }
-    let spec = yawcast_shared::blob::decode_blob(&bytes)
-        .map_err(|e| bad(format!("{}: {e}", path.display())))?;
-    let from_blob = Model::from_spec(&spec).map_err(|e| bad(format!("{}: {e}", path.display())))?;
     let twin = path.with_extension("json");
+    let spec = match yawcast_shared::blob::decode_blob(&bytes) {
+        Ok(spec) => spec,
+        Err(yawcast_shared::blob::BlobError::UnsupportedVersion(v)) if v < FORMAT_VERSION => {
+            // an older blob: the JSON twin holds the same model in f64, whatever the format
+            let tb = std::fs::read(&twin).map_err(|_| {
+                bad(format!(
+                    "{}: model blob format {v} is older than this yawcast's ({FORMAT_VERSION}) \
+                     and its JSON twin {} is not there: identify or export the model again",
+                    path.display(),
+                    twin.display()
+                ))
+            })?;
+            eprintln!(
+                "warning: {}: model blob format {v} is older than {FORMAT_VERSION}: the model is \
+                 read from its JSON twin {}; export it again before loading it on the \
+                 controller",
+                path.display(),
+                twin.display()
+            );
+            return model_from_json(&tb, &twin);
+        }
+        Err(e) => return Err(bad(format!("{}: {e}", path.display()))),
+    };
+    let from_blob = Model::from_spec(&spec).map_err(|e| bad(format!("{}: {e}", path.display())))?;
     if let Ok(tb) = std::fs::read(&twin) {
         if let Ok(m) = model_from_json(&tb, &twin) {
             // The twin must describe the same model as the blob (to f32 precision).
