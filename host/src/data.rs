@@ -552,6 +552,76 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), DataError> {
     res.map_err(io)
 }
 
+/// Gyro-bias estimate from heading: `mean((r(t)+r(t+1))/2 − Δψ/Ts)` with its standard error
+/// from block sums. `None` without heading.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeadingBias {
+    /// Estimated rate-sensor offset (deg/s).
+    pub bias: f64,
+    /// Its standard error (deg/s).
+    pub se: f64,
+    /// Samples used.
+    pub n: usize,
+}
+
+/// Rate-sensor offset seen by the heading channel over `recs` (pooled), or `None` when a
+/// record has no heading.
+///
+/// ```
+/// use yawcast::data::{heading_bias, Record};
+/// // heading turns at 1 °/s, the gyro reads 1.2 °/s
+/// let mut r = Record::from_uy("x", 1.0, vec![0.0; 400], vec![1.2; 400]);
+/// r.psi = Some((0..400).map(|i| i as f64).collect());
+/// let hb = heading_bias(&[r]).unwrap();
+/// assert!((hb.bias - 0.2).abs() < 1e-12);
+/// ```
+pub fn heading_bias(recs: &[Record]) -> Option<HeadingBias> {
+    let mut sum = 0.0;
+    let mut n = 0usize;
+    let mut blocks: Vec<f64> = Vec::new();
+    for r in recs {
+        let psi = r.psi.as_ref()?;
+        if r.len() < 3 {
+            continue;
+        }
+        let m = r.len() - 1;
+        let l = block_len(m);
+        let mut acc = 0.0;
+        let mut cnt = 0;
+        for t in 0..m {
+            let d = 0.5 * (r.y[t] + r.y[t + 1]) - (psi[t + 1] - psi[t]) / r.ts;
+            sum += d;
+            n += 1;
+            acc += d;
+            cnt += 1;
+            if cnt == l {
+                blocks.push(acc);
+                acc = 0.0;
+                cnt = 0;
+            }
+        }
+        if cnt > 0 {
+            blocks.push(acc * l as f64 / cnt as f64);
+        }
+    }
+    if n == 0 {
+        return None;
+    }
+    let mean = sum / n as f64;
+    let l = (n as f64 / blocks.len().max(1) as f64).max(1.0);
+    let var: f64 = blocks.iter().map(|b| (b - mean * l).powi(2)).sum::<f64>();
+    let se = (var.max(0.0)).sqrt() / n as f64;
+    Some(HeadingBias {
+        bias: mean,
+        se: se.max(1e-12),
+        n,
+    })
+}
+
+fn block_len(n: usize) -> usize {
+    ((n as f64).sqrt().round() as usize).clamp(10, 200)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -13,12 +13,22 @@
 //! — `bias` (a steady moment through B) and `gyro-bias` (an offset on the measured rate) —
 //! and takes the one with the lowest BIC if it beats the plain structure's BIC and no longer
 //! needs the slow pole. Otherwise the plain model stands.
+//!
+//! The two look alike on the yaw rate alone (a steady output offset either way), so the one
+//! that reached the lower minimum hands it, converted through the steady gain, to the other
+//! as a further start. The heading tells them apart when every record logs it
+//! ([`heading_bias`]: the gyro's mean reading less the heading's turn): a gyro offset it
+//! shows beyond its noise (the two-sided 0.1 % normal quantile on its block-sum standard
+//! error) has `gyro-bias` tried even when the plain model settles (the offset then sits in
+//! x̂(0) and a slow mode, and simulation drifts); a gyro bias whose value disagrees with the
+//! heading's is not taken, nor a moment when the heading shows a gyro offset and a gyro bias
+//! agrees with it (`by_heading`).
 
 use serde::Serialize;
 use yawcast_shared::model::EffectKind;
 
 use super::{identify_with, IdentError, PemConfig, PemReport};
-use crate::data::Record;
+use crate::data::{heading_bias, Record};
 use crate::model::{Effect, Model};
 
 /// Why an offset effect was added.
@@ -33,8 +43,14 @@ pub struct OffsetChoice {
     pub radius_without: f64,
     /// The same with it.
     pub radius_with: f64,
+    /// What asked for the offset: `"integrator"` (the plain model's slow pole) or
+    /// `"heading"` (a gyro offset the heading shows; the plain model settles).
+    pub reason: &'static str,
     /// BIC with the effect minus BIC without it (negative).
     pub delta_bic: f64,
+    /// The gyro's mean reading less the heading's turn (deg/s) and its standard error, when
+    /// every record logs heading (module docs).
+    pub heading_gyro_bias: Option<[f64; 2]>,
 }
 
 impl OffsetChoice {
@@ -43,8 +59,10 @@ impl OffsetChoice {
     /// ```
     /// use yawcast::pem::offset::OffsetChoice;
     /// let c = OffsetChoice { effect: "bias", value: 2.1, radius_without: 0.9999999,
-    ///                        radius_with: 0.97, delta_bic: -812.0 };
+    ///                        radius_with: 0.97, reason: "integrator", delta_bic: -812.0,
+    ///                        heading_gyro_bias: Some([0.001, 0.002]) };
     /// assert!(c.describe().contains("2.10"));
+    /// assert!(c.describe().contains("+0.0010 ± 0.0020 °/s"));
     /// ```
     pub fn describe(&self) -> String {
         let what = match self.effect {
@@ -57,11 +75,28 @@ impl OffsetChoice {
                 self.value
             ),
         };
+        let heading = match self.heading_gyro_bias {
+            Some([b, se]) => format!(
+                " (the heading: the gyro reads {b:+.4} ± {se:.4} °/s more than the ship turns)"
+            ),
+            None => String::new(),
+        };
+        let without = if self.reason == "heading" {
+            format!(
+                "the heading shows a rate-gyro offset: without a term for it the model holds \
+                 it in its initial state and a slow mode (largest pole {:.5})",
+                self.radius_without
+            )
+        } else {
+            format!(
+                "the records carry a steady offset: without a term for it the search held a \
+                 pole at {:.7} (an integrator, slower than the records)",
+                self.radius_without
+            )
+        };
         format!(
-            "the records carry a steady offset: without a term for it the search held a pole at \
-             {:.7} (an integrator, slower than the records); identified with {what} instead: \
-             largest pole {:.4}, ΔBIC {:+.1}",
-            self.radius_without, self.radius_with, self.delta_bic
+            "{without}; identified with {what} instead: largest pole {:.4}, ΔBIC {:+.1}{heading}",
+            self.radius_with, self.delta_bic
         )
     }
 }
@@ -98,45 +133,153 @@ pub fn identify(
     cfg: &PemConfig,
 ) -> Result<(PemReport, Option<OffsetChoice>), IdentError> {
     let plain = super::identify(records, None, cfg)?;
-    if settles(&plain.model, records) {
+    let hb = heading_bias(records).map(|h| [h.bias, h.se]);
+    let gyro_seen = hb.is_some_and(|[b, se]| (b / se).abs() > Z_HEADING);
+    // an integrator asks for either offset; a gyro offset the heading shows, for that one
+    let kinds: &[EffectKind] = if !settles(&plain.model, records) {
+        &[EffectKind::Bias, EffectKind::GyroBias]
+    } else if gyro_seen {
+        &[EffectKind::GyroBias]
+    } else {
         return Ok((plain, None));
-    }
+    };
     let radius = |m: &Model| {
         let (a, p) = m.spectral_radii();
         a.max(p)
     };
     let radius_without = radius(&plain.model);
-    let tried: Vec<(EffectKind, PemReport)> = [EffectKind::Bias, EffectKind::GyroBias]
+    let fit = |kind: EffectKind, warm: Option<Model>| {
+        let template = plain.model.clone().with_effect(Effect::zero(kind, 0.0));
+        let mut structure = template.clone();
+        structure.a = vec![0.0; structure.n];
+        structure.b = vec![0.0; structure.n];
+        structure.k = vec![0.0; structure.n];
+        // fresh starts for the structure, the plain optimum with the offset at zero, and the
+        // other offset's optimum carried over
+        let starts: Vec<Model> = std::iter::once(template).chain(warm).collect();
+        identify_with(records, Some(&structure), &starts, cfg).ok()
+    };
+    let mut fits: Vec<(EffectKind, Option<PemReport>)> =
+        kinds.iter().map(|&kind| (kind, fit(kind, None))).collect();
+    // A steady moment and a rate offset give the same steady output offset: the one that
+    // found the lower minimum hands it, converted, to the other (whose own starts can stay
+    // on the integrator's minimum, where the offset is held by x̂(0)).
+    let bic = |r: &Option<PemReport>| r.as_ref().map_or(f64::INFINITY, |r| r.bic);
+    let (lo, hi) = if fits.len() < 2 || bic(&fits[0].1) <= bic(&fits[1].1) {
+        (0, 1)
+    } else {
+        (1, 0)
+    };
+    if let Some(warm) = fits
+        .get(hi)
+        .and_then(|h| converted(&fits[lo].1.as_ref()?.model, h.0))
+    {
+        if let Some(r) = fit(fits[hi].0, Some(warm)) {
+            if r.bic < bic(&fits[hi].1) {
+                fits[hi].1 = Some(r);
+            }
+        }
+    }
+    let tried: Vec<(EffectKind, PemReport)> = fits
         .into_iter()
-        .filter_map(|kind| {
-            let template = plain.model.clone().with_effect(Effect::zero(kind, 0.0));
-            let mut structure = template.clone();
-            structure.a = vec![0.0; structure.n];
-            structure.b = vec![0.0; structure.n];
-            structure.k = vec![0.0; structure.n];
-            // fresh starts for the structure, and the plain optimum with the offset at zero
-            identify_with(records, Some(&structure), &[template], cfg)
-                .ok()
-                .map(|r| (kind, r))
-        })
+        .filter_map(|(kind, r)| r.map(|r| (kind, r)))
         .filter(|(_, r)| settles(&r.model, records) && r.bic < plain.bic)
         .collect();
+    let tried = by_heading(tried, hb);
     let Some((kind, rep)) = tried.into_iter().min_by(|a, b| a.1.bic.total_cmp(&b.1.bic)) else {
         return Ok((plain, None));
     };
-    let value = match rep.model.effect(kind) {
-        Some(Effect::Bias { beta }) => *beta,
-        Some(Effect::GyroBias { d_y }) => *d_y,
-        _ => f64::NAN,
-    };
+    let value = offset_value(&rep.model, kind);
     let choice = OffsetChoice {
         effect: kind.name(),
         value,
         radius_without,
         radius_with: radius(&rep.model),
+        reason: if kinds.len() == 2 {
+            "integrator"
+        } else {
+            "heading"
+        },
         delta_bic: rep.bic - plain.bic,
+        heading_gyro_bias: hb,
     };
     Ok((rep, Some(choice)))
+}
+
+/// The two-sided 0.1 % normal quantile: the heading's bar (module docs).
+const Z_HEADING: f64 = 3.29;
+
+/// `model` (with a `bias` or a `gyro-bias`) with the other offset `to` giving the same steady
+/// output offset: `d_y = G(1)·β`, G(1) = C(I − A)⁻¹B the steady gain. `None` when G(1) is
+/// not finite and non-zero.
+fn converted(model: &Model, to: EffectKind) -> Option<Model> {
+    let n = model.n;
+    let i_a = nalgebra::DMatrix::<f64>::identity(n, n) - model.a_matrix();
+    let x = i_a
+        .lu()
+        .solve(&nalgebra::DVector::from_column_slice(&model.b))?;
+    let gain = x[0];
+    if !gain.is_finite() || gain == 0.0 {
+        return None;
+    }
+    let value = match to {
+        EffectKind::Bias => offset_value(model, EffectKind::GyroBias) / gain,
+        _ => offset_value(model, EffectKind::Bias) * gain,
+    };
+    if !value.is_finite() {
+        return None;
+    }
+    let mut m = model.clone();
+    m.effects.clear();
+    Some(m.with_effect(match to {
+        EffectKind::Bias => Effect::Bias { beta: value },
+        _ => Effect::GyroBias { d_y: value },
+    }))
+}
+
+fn offset_value(model: &Model, kind: EffectKind) -> f64 {
+    match model.effect(kind) {
+        Some(Effect::Bias { beta }) => *beta,
+        Some(Effect::GyroBias { d_y }) => *d_y,
+        _ => f64::NAN,
+    }
+}
+
+/// The candidates the heading channel (`[gyro offset, its standard error]`) does not rule
+/// out. A gyro bias stands when its value agrees with the heading's: within the two
+/// standard errors (heading's and the identification's) at [`Z_HEADING`], or within half the
+/// heading's offset — the identified value also carries what the linear dynamics make of the
+/// offset. A moment is ruled out when the heading shows a gyro offset and a gyro bias stands.
+/// Without heading, all.
+fn by_heading(
+    tried: Vec<(EffectKind, PemReport)>,
+    hb: Option<[f64; 2]>,
+) -> Vec<(EffectKind, PemReport)> {
+    let Some([b, se]) = hb else {
+        return tried;
+    };
+    let gyro_seen = (b / se).abs() > Z_HEADING;
+    let gyro_fits = |rep: &PemReport| {
+        let d = offset_value(&rep.model, EffectKind::GyroBias);
+        let sd = rep
+            .names
+            .iter()
+            .position(|n| n.ends_with("d_y"))
+            .and_then(|i| rep.std.get(i).copied())
+            .filter(|v| v.is_finite())
+            .unwrap_or(0.0);
+        (d - b).abs() <= (Z_HEADING * se.hypot(sd)).max(0.5 * b.abs())
+    };
+    let gyro_stands = tried
+        .iter()
+        .any(|(k, r)| *k == EffectKind::GyroBias && gyro_fits(r));
+    tried
+        .into_iter()
+        .filter(|(k, r)| match k {
+            EffectKind::GyroBias => gyro_fits(r),
+            _ => !(gyro_seen && gyro_stands),
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -211,7 +354,7 @@ mod tests {
             steady(&rep.model)
         );
         assert!(c.effect == "bias" || c.effect == "gyro-bias", "{c:?}");
-        assert!(c.radius_with < 0.99, "{c:?}");
+        assert!(c.radius_with < 0.995 && settles(&rep.model, &recs), "{c:?}");
         assert!(c.delta_bic < 0.0);
         // and it simulates a fresh record at least as well as the integrator does
         let fresh = record(&truth, 3);
@@ -225,6 +368,49 @@ mod tests {
             sim(&rep.model),
             sim(&plain.model)
         );
+    }
+
+    /// `record` with a heading: the integral of the ship's true rate (`rate_model`, without
+    /// any gyro offset) plus 0.05° of white noise.
+    fn with_heading(truth: &Model, rate_model: &Model, seed: usize) -> Record {
+        let mut rec = record(truth, seed);
+        let r = predict::simulate(rate_model, &rec, &vec![0.0; rate_model.n]);
+        let mut psi = Vec::with_capacity(r.len());
+        let mut h = 30.0;
+        let mut s = 0x2545_f491_4f6c_dd1du64 ^ seed as u64;
+        for i in 0..r.len() {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            psi.push(h + 0.1 * ((s >> 11) as f64 / (1u64 << 53) as f64 - 0.5));
+            if i + 1 < r.len() {
+                h += 0.5 * (r[i] + r[i + 1]) * rec.ts;
+            }
+        }
+        rec.psi = Some(psi);
+        rec
+    }
+
+    #[test]
+    fn the_heading_tells_a_moment_from_a_gyro_offset() {
+        let moment = ship().with_effect(Effect::Bias { beta: 2.0 });
+        let still = Record::from_uy("still", 1.0, vec![0.0; 4000], vec![0.0; 4000]);
+        let steady = *predict::simulate(&moment, &still, &[0.0; 4])
+            .last()
+            .unwrap();
+        // a gyro offset that gives the same steady rate offset
+        let gyro = ship().with_effect(Effect::GyroBias { d_y: steady });
+        let cfg = PemConfig::default();
+        for (truth, rate, want) in [(&moment, &moment, "bias"), (&gyro, &ship(), "gyro-bias")] {
+            let recs = [with_heading(truth, rate, 1), with_heading(truth, rate, 2)];
+            let (rep, choice) = identify(&recs, &cfg).unwrap();
+            let c = choice.unwrap_or_else(|| panic!("{want}: {:?}", rep.model.spectral_radii()));
+            assert_eq!(c.effect, want, "{c:?}");
+            let [b, se] = c.heading_gyro_bias.unwrap();
+            let true_gyro = if want == "bias" { 0.0 } else { steady };
+            assert!((b - true_gyro).abs() < 4.0 * se, "{c:?}");
+            assert!(c.describe().contains("more than the ship turns"));
+        }
     }
 
     #[test]
