@@ -1744,7 +1744,11 @@ mod tests {
     }
 
     fn records(kind: Option<(EffectKind, f64)>, seeds: &[u64]) -> Vec<Record> {
-        let ship = Ship::default_lng();
+        ship_records(&Ship::default_lng(), kind, seeds)
+    }
+
+    /// Noisy records of `ship` with one hidden effect at a scale, or none.
+    fn ship_records(ship: &Ship, kind: Option<(EffectKind, f64)>, seeds: &[u64]) -> Vec<Record> {
         let mut sc = match kind {
             Some((k, s)) => Scenario::with_effect(SimEffect::hidden(k, s)),
             None => Scenario::default(),
@@ -1752,7 +1756,7 @@ mod tests {
         sc.noise = noise();
         seeds
             .par_iter()
-            .map(|&s| simulate(&ship, &sc, s).unwrap())
+            .map(|&s| simulate(ship, &sc, s).unwrap())
             .collect()
     }
 
@@ -2132,15 +2136,7 @@ mod tests {
         let mut ship = Ship::default_lng();
         ship.actuator.slew_degps = 4.0;
         ship.actuator.servo_tau_s = 2.5;
-        let mut sc = match kind {
-            Some(k) => Scenario::with_effect(SimEffect::hidden(k, 1.0)),
-            None => Scenario::default(),
-        };
-        sc.noise = noise();
-        seeds
-            .par_iter()
-            .map(|&s| simulate(&ship, &sc, s).unwrap())
-            .collect()
+        ship_records(&ship, kind.map(|k| (k, 1.0)), seeds)
     }
 
     #[test]

@@ -109,7 +109,7 @@ fn settles(model: &Model, recs: &[Record]) -> bool {
 }
 
 /// [`super::identify`] of the plain structure, with an offset effect added when the plain
-/// model needs an integrator to carry one (module docs). The effect's gain is estimated
+/// model needs an integrator to carry one or the heading shows a gyro offset (module docs). The effect's gain is estimated
 /// with θ; the returned choice is `None` when the plain model stands.
 ///
 /// # Errors
