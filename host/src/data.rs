@@ -576,20 +576,50 @@ pub struct HeadingBias {
 /// assert!((hb.bias - 0.2).abs() < 1e-12);
 /// ```
 pub fn heading_bias(recs: &[Record]) -> Option<HeadingBias> {
-    let mut sum = 0.0;
-    let mut n = 0usize;
-    let mut blocks: Vec<f64> = Vec::new();
+    let mut series = Vec::with_capacity(recs.len());
     for r in recs {
         let psi = r.psi.as_ref()?;
         if r.len() < 3 {
             continue;
         }
-        let m = r.len() - 1;
+        series.push(
+            (0..r.len() - 1)
+                .map(|t| 0.5 * (r.y[t] + r.y[t + 1]) - (psi[t + 1] - psi[t]) / r.ts)
+                .collect::<Vec<f64>>(),
+        );
+    }
+    let (bias, se, n) = block_mean(&series)?;
+    Some(HeadingBias { bias, se, n })
+}
+
+/// Pooled mean of `series` with its standard error from block sums — blocks of about √m
+/// samples (10 to 200) within each series of m values, so serial correlation inside a block
+/// counts — and the number of values used. Non-finite values (missing samples) are skipped;
+/// `None` when none is left.
+///
+/// ```
+/// // 500 zeros then 500 ones: the mean is 0.5; the blocks see the two halves, so the
+/// // standard error is far above the white-noise 0.5/√1000 = 0.016
+/// let mut s = vec![0.0; 500];
+/// s.extend([1.0; 500]);
+/// s.push(f64::NAN); // a missing sample is skipped
+/// let (mean, se, n) = yawcast::data::block_mean(&[s]).unwrap();
+/// assert_eq!((mean, n), (0.5, 1000));
+/// assert!(se > 0.05, "{se}");
+/// ```
+pub fn block_mean(series: &[Vec<f64>]) -> Option<(f64, f64, usize)> {
+    let mut sum = 0.0;
+    let mut n = 0usize;
+    let mut blocks: Vec<f64> = Vec::new();
+    for s in series {
+        let m = s.iter().filter(|v| v.is_finite()).count();
+        if m == 0 {
+            continue;
+        }
         let l = block_len(m);
         let mut acc = 0.0;
         let mut cnt = 0;
-        for t in 0..m {
-            let d = 0.5 * (r.y[t] + r.y[t + 1]) - (psi[t + 1] - psi[t]) / r.ts;
+        for &d in s.iter().filter(|v| v.is_finite()) {
             sum += d;
             n += 1;
             acc += d;
@@ -611,11 +641,7 @@ pub fn heading_bias(recs: &[Record]) -> Option<HeadingBias> {
     let l = (n as f64 / blocks.len().max(1) as f64).max(1.0);
     let var: f64 = blocks.iter().map(|b| (b - mean * l).powi(2)).sum::<f64>();
     let se = (var.max(0.0)).sqrt() / n as f64;
-    Some(HeadingBias {
-        bias: mean,
-        se: se.max(1e-12),
-        n,
-    })
+    Some((mean, se.max(1e-12), n))
 }
 
 fn block_len(n: usize) -> usize {

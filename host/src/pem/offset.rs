@@ -12,24 +12,29 @@
 //! with each offset effect of the library
 //! — `bias` (a steady moment through B) and `gyro-bias` (an offset on the measured rate) —
 //! and takes the one with the lowest BIC if it beats the plain structure's BIC and no longer
-//! needs the slow pole. Otherwise the plain model stands.
+//! needs the slow pole. A plain model that settles can still lack the offset: its
+//! predictor then passes it into the one-step errors, whose mean is tested against their
+//! block-sum standard error (two-sided 0.1 %); a mean beyond it asks for the same two
+//! candidates. Otherwise the plain model stands.
 //!
 //! The two look alike on the yaw rate alone (a steady output offset either way), so the one
 //! that reached the lower minimum hands it, converted through the steady gain, to the other
 //! as a further start. The heading tells them apart when every record logs it
-//! ([`heading_bias`]: the gyro's mean reading less the heading's turn): a gyro offset it
-//! shows beyond its noise (the two-sided 0.1 % normal quantile on its block-sum standard
-//! error) has `gyro-bias` tried even when the plain model settles (the offset then sits in
-//! x̂(0) and a slow mode, and simulation drifts); a gyro bias whose value disagrees with the
-//! heading's is not taken, nor a moment when the heading shows a gyro offset and a gyro bias
-//! agrees with it (`by_heading`).
-
+//! ([`heading_bias`]: the gyro's mean reading less the heading's turn, b ± se). That is a
+//! measurement of the gyro offset the yaw-rate likelihood does not hold, so it enters the
+//! criterion as one more Gaussian term: BIC + ((b − d)/s)², d the model's gyro offset (0
+//! without `gyro-bias`) and s the heading's standard error combined with the identified
+//! offset's. A moment then cannot stand in for an offset the heading shows, nor a gyro bias
+//! for one it does not. A gyro offset the heading shows beyond its noise (the two-sided
+//! 0.1 % normal quantile) has `gyro-bias` tried even when the plain model settles (the offset
+//! then sits in x̂(0) and a slow mode, and simulation drifts).
 use serde::Serialize;
 use yawcast_shared::model::EffectKind;
 
 use super::{identify_with, IdentError, PemConfig, PemReport};
-use crate::data::{heading_bias, Record};
+use crate::data::{block_mean, heading_bias, Record};
 use crate::model::{Effect, Model};
+use crate::predict;
 
 /// Why an offset effect was added.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -43,10 +48,12 @@ pub struct OffsetChoice {
     pub radius_without: f64,
     /// The same with it.
     pub radius_with: f64,
-    /// What asked for the offset: `"integrator"` (the plain model's slow pole) or
-    /// `"heading"` (a gyro offset the heading shows; the plain model settles).
+    /// What asked for the offset: `"integrator"` (the plain model's slow pole),
+    /// `"residual-mean"` (the plain model settles but its one-step errors are not centred)
+    /// or `"heading"` (only the heading shows an offset: a gyro offset).
     pub reason: &'static str,
-    /// BIC with the effect minus BIC without it (negative).
+    /// BIC with the effect minus BIC without it, the heading's term included when every
+    /// record logs heading (module docs; negative).
     pub delta_bic: f64,
     /// The gyro's mean reading less the heading's turn (deg/s) and its standard error, when
     /// every record logs heading (module docs).
@@ -85,6 +92,12 @@ impl OffsetChoice {
             format!(
                 "the heading shows a rate-gyro offset: without a term for it the model holds \
                  it in its initial state and a slow mode (largest pole {:.5})",
+                self.radius_without
+            )
+        } else if self.reason == "residual-mean" {
+            format!(
+                "the records carry a steady offset: without a term for it the model's one-step \
+                 errors are not centred (largest pole {:.5})",
                 self.radius_without
             )
         } else {
@@ -134,9 +147,11 @@ pub fn identify(
 ) -> Result<(PemReport, Option<OffsetChoice>), IdentError> {
     let plain = super::identify(records, None, cfg)?;
     let hb = heading_bias(records).map(|h| [h.bias, h.se]);
-    let gyro_seen = hb.is_some_and(|[b, se]| (b / se).abs() > Z_HEADING);
-    // an integrator asks for either offset; a gyro offset the heading shows, for that one
-    let kinds: &[EffectKind] = if !settles(&plain.model, records) {
+    let gyro_seen = hb.is_some_and(|[b, se]| (b / se).abs() > Z_BAR);
+    // an integrator or a one-step error that is not centred asks for either offset; a gyro
+    // offset the heading shows, for that one
+    let integrator = !settles(&plain.model, records);
+    let kinds: &[EffectKind] = if integrator || off_centre(&plain, records) {
         &[EffectKind::Bias, EffectKind::GyroBias]
     } else if gyro_seen {
         &[EffectKind::GyroBias]
@@ -183,10 +198,18 @@ pub fn identify(
     let tried: Vec<(EffectKind, PemReport)> = fits
         .into_iter()
         .filter_map(|(kind, r)| r.map(|r| (kind, r)))
-        .filter(|(_, r)| settles(&r.model, records) && r.bic < plain.bic)
+        .filter(|(_, r)| settles(&r.model, records))
         .collect();
-    let tried = by_heading(tried, hb);
-    let Some((kind, rep)) = tried.into_iter().min_by(|a, b| a.1.bic.total_cmp(&b.1.bic)) else {
+    let plain_bic = plain.bic + heading_term(&plain, hb);
+    let Some((kind, rep, total)) = tried
+        .into_iter()
+        .map(|(k, r)| {
+            let total = r.bic + heading_term(&r, hb);
+            (k, r, total)
+        })
+        .filter(|(_, _, total)| *total < plain_bic)
+        .min_by(|a, b| a.2.total_cmp(&b.2))
+    else {
         return Ok((plain, None));
     };
     let value = offset_value(&rep.model, kind);
@@ -195,19 +218,21 @@ pub fn identify(
         value,
         radius_without,
         radius_with: radius(&rep.model),
-        reason: if kinds.len() == 2 {
+        reason: if integrator {
             "integrator"
+        } else if kinds.len() == 2 {
+            "residual-mean"
         } else {
             "heading"
         },
-        delta_bic: rep.bic - plain.bic,
+        delta_bic: total - plain_bic,
         heading_gyro_bias: hb,
     };
     Ok((rep, Some(choice)))
 }
 
-/// The two-sided 0.1 % normal quantile: the heading's bar (module docs).
-const Z_HEADING: f64 = 3.29;
+/// The two-sided 0.1 % normal quantile: the bar for a mean beyond its noise (module docs).
+const Z_BAR: f64 = 3.29;
 
 /// `model` (with a `bias` or a `gyro-bias`) with the other offset `to` giving the same steady
 /// output offset: `d_y = G(1)·β`, G(1) = C(I − A)⁻¹B the steady gain. `None` when G(1) is
@@ -245,41 +270,43 @@ fn offset_value(model: &Model, kind: EffectKind) -> f64 {
     }
 }
 
-/// The candidates the heading channel (`[gyro offset, its standard error]`) does not rule
-/// out. A gyro bias stands when its value agrees with the heading's: within the two
-/// standard errors (heading's and the identification's) at [`Z_HEADING`], or within half the
-/// heading's offset — the identified value also carries what the linear dynamics make of the
-/// offset. A moment is ruled out when the heading shows a gyro offset and a gyro bias stands.
-/// Without heading, all.
-fn by_heading(
-    tried: Vec<(EffectKind, PemReport)>,
-    hb: Option<[f64; 2]>,
-) -> Vec<(EffectKind, PemReport)> {
-    let Some([b, se]) = hb else {
-        return tried;
-    };
-    let gyro_seen = (b / se).abs() > Z_HEADING;
-    let gyro_fits = |rep: &PemReport| {
-        let d = offset_value(&rep.model, EffectKind::GyroBias);
-        let sd = rep
-            .names
-            .iter()
-            .position(|n| n.ends_with("d_y"))
-            .and_then(|i| rep.std.get(i).copied())
-            .filter(|v| v.is_finite())
-            .unwrap_or(0.0);
-        (d - b).abs() <= (Z_HEADING * se.hypot(sd)).max(0.5 * b.abs())
-    };
-    let gyro_stands = tried
+/// Whether the plain model's one-step errors have a mean beyond their noise (the block-sum
+/// standard error at [`Z_BAR`]): a settling predictor passes a steady offset it has no
+/// term for into its errors, scaled by its noise model's steady gain.
+fn off_centre(plain: &PemReport, records: &[Record]) -> bool {
+    let errors: Vec<Vec<f64>> = records
         .iter()
-        .any(|(k, r)| *k == EffectKind::GyroBias && gyro_fits(r));
-    tried
-        .into_iter()
-        .filter(|(k, r)| match k {
-            EffectKind::GyroBias => gyro_fits(r),
-            _ => !(gyro_seen && gyro_stands),
+        .zip(&plain.x0)
+        .map(|(r, x0)| {
+            let yhat = predict::one_step(&plain.model, r, x0);
+            r.y.iter().zip(&yhat).map(|(y, p)| y - p).collect()
         })
-        .collect()
+        .collect();
+    block_mean(&errors).is_some_and(|(mean, se, _)| (mean / se).abs() > Z_BAR)
+}
+
+/// The heading's term of the criterion (module docs): `((b − d)/s)²`, d the gyro offset of
+/// `rep`'s model (0 without one), s the heading's standard error combined with the
+/// identification's for d. 0 without heading.
+fn heading_term(rep: &PemReport, hb: Option<[f64; 2]>) -> f64 {
+    let Some([b, se]) = hb else {
+        return 0.0;
+    };
+    let Some(d) = rep
+        .model
+        .effect(EffectKind::GyroBias)
+        .map(|_| offset_value(&rep.model, EffectKind::GyroBias))
+    else {
+        return (b / se).powi(2);
+    };
+    let sd = rep
+        .names
+        .iter()
+        .position(|n| n.ends_with("d_y"))
+        .and_then(|i| rep.std.get(i).copied())
+        .filter(|v| v.is_finite())
+        .unwrap_or(0.0);
+    ((b - d) / se.hypot(sd)).powi(2)
 }
 
 #[cfg(test)]
@@ -410,6 +437,47 @@ mod tests {
             let true_gyro = if want == "bias" { 0.0 } else { steady };
             assert!((b - true_gyro).abs() < 4.0 * se, "{c:?}");
             assert!(c.describe().contains("more than the ship turns"));
+        }
+    }
+
+    #[test]
+    fn a_moment_a_settling_model_leaves_in_its_errors_is_found_by_their_mean() {
+        use crate::sim::{simulate, Scenario, Ship, SimEffect};
+        let ship = Ship::default_lng();
+        let cfg = PemConfig::default();
+        let moment = Scenario::with_effect(SimEffect::hidden(EffectKind::Bias, 1.0));
+        let mut by_mean = 0;
+        for seed in 1..=6u64 {
+            let recs = [simulate(&ship, &moment, seed).unwrap()];
+            let plain = super::super::identify(&recs, None, &cfg).unwrap();
+            let (rep, choice) = identify(&recs, &cfg).unwrap();
+            let c = choice.unwrap_or_else(|| panic!("seed {seed}: no offset"));
+            assert_eq!(c.effect, "bias", "seed {seed}: {c:?}");
+            if settles(&plain.model, &recs) {
+                // the settling plain model left the moment in its errors' mean
+                assert!(off_centre(&plain, &recs), "seed {seed}");
+                assert_eq!(c.reason, "residual-mean", "seed {seed}: {c:?}");
+                by_mean += 1;
+                // and the model with it simulates a fresh record better
+                let fresh = simulate(&ship, &moment, 100 + seed).unwrap();
+                let sim = |m: &Model| {
+                    let x0 = predict::estimate_x0(m, &fresh);
+                    predict::fit(&fresh.y, &predict::simulate(m, &fresh, &x0))
+                };
+                assert!(
+                    sim(&rep.model) > sim(&plain.model) + 1.0,
+                    "seed {seed}: {} vs {}",
+                    sim(&rep.model),
+                    sim(&plain.model)
+                );
+            }
+        }
+        assert!(by_mean >= 3, "{by_mean}");
+        // the clean ship's errors are centred
+        for seed in 1..=6u64 {
+            let clean = [simulate(&ship, &Scenario::default(), seed).unwrap()];
+            let p = super::super::identify(&clean, None, &cfg).unwrap();
+            assert!(!off_centre(&p, &clean), "seed {seed}");
         }
     }
 
