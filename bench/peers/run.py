@@ -1157,14 +1157,16 @@ def _finite(v):
 def run_case_yawcast(yc, case, mdir, rows, args, log_print):
     seed = args.seed
     # plain PEM, on the same mean-removed estimation record every peer sees (the operating point
-    # is added back when predicting, as for the peers)
+    # is added back when predicting, as for the peers). Without the heading, as the peers: a
+    # rate with its mean removed no longer matches the heading's turn, which identify would
+    # read as a gyro offset.
     pem = mdir / "yawcast-pem.postcard"
     row = {"case": case.name, "effect": case.effect, "seed": case.seed, "tool": "yawcast-pem"}
     try:
         est = read_record(case.est)
         u0, y0 = _center(est)
         centered = mdir / "est-centered.csv"
-        write_record(centered, Record(est.name, est.ts, est.u - u0, est.y - y0, est.psi))
+        write_record(centered, Record(est.name, est.ts, est.u - u0, est.y - y0, None))
         wall, t_in, _ = yc.identify(centered, pem, seed)
         row.update(wall_s=wall, inproc_s=t_in, model=str(yc.twin(pem)), u0=u0, y0=y0)
     except Exception as e:  # noqa: BLE001
@@ -1249,7 +1251,7 @@ def score_rows(rows, cases_by_name, yc, work, log_print):
                     # the same shift on the validation record; fit is unchanged by it
                     vpath = Path(row["model"]).parent / "val-centered.csv"
                     write_record(vpath, Record(val.name, val.ts, val.u - model.u0, val.y - model.y0,
-                                               val.psi))
+                                               None))
                 doc = yc.compare(Path(row["model"]).with_suffix(".postcard"), vpath, cj)
                 theirs = _compare_fits(doc)
                 if theirs:
@@ -1658,7 +1660,7 @@ def notes(meta, args):
         "predictions fed back; the first 4 samples are the recursion's initial condition. Its block-wise "
         "`steps_ahead` is not used. Our recursion reproduces sysidentpy's own one-step and free-run "
         "predictions to 1e-8 (`run.py selftest`).",
-        "- yawcast: `identify` (plain PEM, λ = 0) on the same mean-removed estimation record the peers see "
+        "- yawcast: `identify` (plain PEM, λ = 0) on the same mean-removed estimation record the peers see, without its heading as they "
         "(operating point added back when predicting, as for them), and `identify --focus 1,5,10,20` (the PEM "
         "optimum refined on the mean of its 1-, 5-, 10- and 20-step errors, each relative to the start's); `tune` (GA over λ, R, the paper's recipe: PEM on the clean simulator's record, fitness = k-step fit on the estimation record as the trial); `diagnose` "
         "against the clean simulator's record, then `augment --more` with the diagnosed effect (`--effect none` "
