@@ -389,13 +389,13 @@ pub fn unwrap_degrees(psi: &mut [f64]) {
 
 /// Checks that `t` advances one sample per period and returns the period.
 ///
-/// The period is the median of the steps that go forward. Logged time stamps jitter: a row may come late or early
-/// (the step before it is then longer or shorter, the one after it the opposite), and each
-/// row still holds one sample as long as every step is within half a period of the period —
-/// stamps off their grid by up to a quarter period each. The sample time returned is the
-/// slope of the least-squares line through the stamps, snapped to a value of at most three
-/// significant digits within [`SNAP_TOL`] of it (a logger at 1 Hz with jitter gives 1 s, not
-/// 0.99943 s).
+/// The period is the median of the steps that go forward. Logged time stamps jitter: a row
+/// may come late or early (the step before it is then longer or shorter, the one after it
+/// the opposite), and each row still holds one sample as long as every step is within half
+/// a period of the period — stamps off their grid by up to a quarter period each. The
+/// sample time returned is the slope of the least-squares line through the stamps, snapped
+/// to a value of at most three significant digits within [`SNAP_TOL`] of it (a logger at
+/// 1 Hz with jitter gives 1 s, not 0.99943 s).
 ///
 /// # Errors
 /// [`DataError::NonUniform`] naming the first row whose step is not positive (time going

@@ -162,9 +162,10 @@ pub struct IdentifySummary {
     pub start: pem::Start,
     /// Set when that minimum is not the lowest-cost one: the test that chose it.
     pub start_choice: Option<pem::choose::StartChoice>,
-    /// Set when the records carry a steady offset the plain structure could only hold with
-    /// a pole on the unit circle: the offset effect added instead (`effect`, `value`,
-    /// `radius_without`, `radius_with`, `delta_bic`).
+    /// Set when the records carry a steady offset the plain structure has no term for (held
+    /// by a pole on the unit circle, left in the mean of its one-step errors, or shown by
+    /// the heading): the offset effect added (`effect`, `value`, `radius_without`,
+    /// `radius_with`, `reason`, `delta_bic`, `heading_gyro_bias`).
     pub offset: Option<pem::offset::OffsetChoice>,
 }
 

@@ -11,8 +11,8 @@
 //! the records cannot tell such a mode from a constant), it identifies the structure again
 //! with each offset effect of the library
 //! — `bias` (a steady moment through B) and `gyro-bias` (an offset on the measured rate) —
-//! and takes the one with the lowest BIC if it beats the plain structure's BIC and no longer
-//! needs the slow pole. A plain model that settles can still lack the offset: its
+//! and takes the one with the lowest criterion (BIC, with the heading's term below) if it
+//! beats the plain structure's and no longer needs the slow pole. A plain model that settles can still lack the offset: its
 //! predictor then passes it into the one-step errors, whose mean is tested against their
 //! block-sum standard error (two-sided 0.1 %); a mean beyond it asks for the same two
 //! candidates. Otherwise the plain model stands.
@@ -28,6 +28,7 @@
 //! for one it does not. A gyro offset the heading shows beyond its noise (the two-sided
 //! 0.1 % normal quantile) has `gyro-bias` tried even when the plain model settles (the offset
 //! then sits in x̂(0) and a slow mode, and simulation drifts).
+
 use serde::Serialize;
 use yawcast_shared::model::EffectKind;
 
@@ -43,8 +44,8 @@ pub struct OffsetChoice {
     pub effect: &'static str,
     /// Its estimated value (bias: degrees of command; gyro bias: deg/s).
     pub value: f64,
-    /// Largest pole modulus of A and A − KC without the effect (the pole that stood in for
-    /// the offset).
+    /// Largest pole modulus of A and A − KC without the effect (with `reason`
+    /// `"integrator"`, the pole that stood in for the offset).
     pub radius_without: f64,
     /// The same with it.
     pub radius_with: f64,
@@ -292,11 +293,7 @@ fn heading_term(rep: &PemReport, hb: Option<[f64; 2]>) -> f64 {
     let Some([b, se]) = hb else {
         return 0.0;
     };
-    let Some(d) = rep
-        .model
-        .effect(EffectKind::GyroBias)
-        .map(|_| offset_value(&rep.model, EffectKind::GyroBias))
-    else {
+    let Some(Effect::GyroBias { d_y: d }) = rep.model.effect(EffectKind::GyroBias) else {
         return (b / se).powi(2);
     };
     let sd = rep
@@ -306,7 +303,7 @@ fn heading_term(rep: &PemReport, hb: Option<[f64; 2]>) -> f64 {
         .and_then(|i| rep.std.get(i).copied())
         .filter(|v| v.is_finite())
         .unwrap_or(0.0);
-    ((b - d) / se.hypot(sd)).powi(2)
+    ((b - *d) / se.hypot(sd)).powi(2)
 }
 
 #[cfg(test)]
