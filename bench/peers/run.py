@@ -179,7 +179,7 @@ def standin_record(name, seed, n=2000, ts=0.5, noise=0.05, effect=None):
 class SSModel:
     """x(t+1) = A x + B v + K e;  ŷ = C x + D ũ + d_y + y0;  ũ = actuator(u − u0);
     v = ũ + Σ β φ (yawcast effects; empty for peers).  Step semantics follow DESIGN.md
-    and host/src/predict.rs: actuator (dead time → saturation → rate limit), heading,
+    and host/src/identify/predict.rs: actuator (dead time → saturation → rate limit), heading,
     y_used, effect regressors, innovation, state update, heading integration."""
 
     def __init__(self, A, B, C, D=0.0, K=None, u0=0.0, y0=0.0, ts=1.0, effects=None, name=""):
@@ -1671,7 +1671,7 @@ def notes(meta, args):
         "need it as much); when the model written carries no effect, the row is plain PEM on the raw estimation "
         "record. Its models are read from the JSON twin (a, b, k and the effects) and scored by the same "
         "predictor, effects included (dead time → saturation → rate limit, bias, asymmetry, damping, heading "
-        "terms, gyro bias), as `host/src/predict.rs` defines them.",
+        "terms, gyro bias), as `host/src/identify/predict.rs` defines them.",
     ]
     if meta.get("compare_max_delta") is not None:
         N.append(f"- Cross-check: `yawcast compare --json` on the same models and records agrees with the shared "

@@ -4,9 +4,9 @@
 //! dead time.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use yawcast::augment::{self, AugmentConfig};
+use yawcast::diagnose::augment::{self, AugmentConfig};
 use yawcast::diagnose::{self, DiagnoseConfig};
-use yawcast::pem::{self, PemConfig};
+use yawcast::identify::pem::{self, PemConfig};
 use yawcast::sim::{self, NoiseSpec, Scenario, Ship, SimEffect};
 use yawcast_shared::model::EffectKind;
 

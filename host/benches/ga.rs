@@ -8,11 +8,11 @@ use std::time::Instant;
 use criterion::{criterion_group, criterion_main, Criterion};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use yawcast::data::Record;
-use yawcast::ga::{self, GaConfig};
-use yawcast::model::{Effect, Model};
-use yawcast::pem::{self, PemConfig};
-use yawcast::predict::Stepper;
+use yawcast::identify::model::{Effect, Model};
+use yawcast::identify::pem::{self, PemConfig};
+use yawcast::identify::predict::Stepper;
+use yawcast::io::data::Record;
+use yawcast::tune::ga::{self, GaConfig};
 
 /// A stable 4th-order canonical model (A poles 0.95, 0.85, 0.6 ± 0.25i).
 fn truth() -> Model {

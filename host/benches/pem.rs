@@ -4,10 +4,10 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use yawcast::data::Record;
-use yawcast::model::Model;
-use yawcast::pem::{self, PemConfig};
-use yawcast::predict::Stepper;
+use yawcast::identify::model::Model;
+use yawcast::identify::pem::{self, PemConfig};
+use yawcast::identify::predict::Stepper;
+use yawcast::io::data::Record;
 
 /// A stable 4th-order canonical model (A poles 0.95, 0.85, 0.6 ± 0.25i).
 fn truth() -> Model {

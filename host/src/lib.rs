@@ -1,22 +1,16 @@
 //! yawcast: ship-trial data to a yaw-rate predictor — simulator, identification, tuning,
 //! diagnosis and export. f64 throughout; firmware-exact numbers come from `yawcast-firmware`.
+//!
+//! The modules follow the data flow: [`sim`] (records of a simulated ship) → [`identify`]
+//! (PEM, the f64 model and predictor, several trials into one model) → [`tune`] (GA over the
+//! regularisation) → [`diagnose`] (compare, residual tests, which effect is missing, augment)
+//! → [`io`] (records in, the blob out, reports, hardware in the loop) → the firmware.
 #![deny(missing_docs)]
 
-pub mod augment;
-pub mod compare;
-pub mod data;
 pub mod demo;
 pub mod diagnose;
-pub mod export;
-pub mod ga;
-pub mod hil;
-pub mod merge;
-pub mod model;
-pub mod nmea;
+pub mod identify;
+pub mod io;
 mod par;
-pub mod pem;
-pub mod predict;
-pub mod report;
-pub mod resid;
 pub mod sim;
-pub mod tables;
+pub mod tune;

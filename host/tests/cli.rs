@@ -865,7 +865,7 @@ fn sim_csvs(
         .map(|&seed| {
             let rec = simulate(&Ship::default_lng(), &sc, seed).unwrap();
             let p = dir.join(format!("{name}-{seed}.csv"));
-            yawcast::data::write_csv(&p, &rec).unwrap();
+            yawcast::io::data::write_csv(&p, &rec).unwrap();
             p
         })
         .collect()
@@ -893,7 +893,7 @@ fn augment_auto_on_a_slow_gear_reference_names_and_keeps_a_slower_slew_limit() {
             .map(|&seed| {
                 let rec = simulate(&ship, &sc, seed).unwrap();
                 let p = d.join(format!("{name}-{seed}.csv"));
-                yawcast::data::write_csv(&p, &rec).unwrap();
+                yawcast::io::data::write_csv(&p, &rec).unwrap();
                 p
             })
             .collect()
@@ -901,9 +901,9 @@ fn augment_auto_on_a_slow_gear_reference_names_and_keeps_a_slower_slew_limit() {
     let reference = write("ref", None, &[501, 502]);
     let recs: Vec<_> = reference
         .iter()
-        .map(|p| yawcast::data::read_csv(p).unwrap())
+        .map(|p| yawcast::io::data::read_csv(p).unwrap())
         .collect();
-    let base = yawcast::pem::identify(&recs, None, &Default::default())
+    let base = yawcast::identify::pem::identify(&recs, None, &Default::default())
         .unwrap()
         .model;
     let model = d.join("base.json");
@@ -966,9 +966,9 @@ fn augment_adds_a_dead_time_exports_it_and_writes_the_ship() {
     let reference = sim_csvs(&d, "ref", None, &[301, 302]);
     let recs: Vec<_> = reference
         .iter()
-        .map(|p| yawcast::data::read_csv(p).unwrap())
+        .map(|p| yawcast::io::data::read_csv(p).unwrap())
         .collect();
-    let base = yawcast::pem::identify(&recs, None, &Default::default())
+    let base = yawcast::identify::pem::identify(&recs, None, &Default::default())
         .unwrap()
         .model;
     let model = d.join("base.json");
@@ -1042,10 +1042,10 @@ fn augment_adds_a_dead_time_exports_it_and_writes_the_ship() {
     // the blob decodes to the model with the dead time; the twin sits beside it
     let blob = std::fs::read(&out).unwrap();
     let spec = yawcast_shared::blob::decode_blob(&blob).unwrap();
-    let m = yawcast::model::Model::from_spec(&spec).unwrap();
+    let m = yawcast::identify::model::Model::from_spec(&spec).unwrap();
     assert_eq!(
         m.effect(EffectKind::DeadTime),
-        Some(&yawcast::model::Effect::DeadTime { samples: 2 })
+        Some(&yawcast::identify::model::Effect::DeadTime { samples: 2 })
     );
     assert!(d.join("aug.json").exists());
     let ship_back = yawcast::sim::Ship::from_file(&ship).unwrap();
@@ -1099,9 +1099,9 @@ fn augment_more_searches_the_library_and_pins_its_json() {
     let reference = sim_csvs(&d, "ref", None, &[311, 312]);
     let recs: Vec<_> = reference
         .iter()
-        .map(|p| yawcast::data::read_csv(p).unwrap())
+        .map(|p| yawcast::io::data::read_csv(p).unwrap())
         .collect();
-    let base = yawcast::pem::identify(&recs, None, &Default::default())
+    let base = yawcast::identify::pem::identify(&recs, None, &Default::default())
         .unwrap()
         .model;
     let model = d.join("base.json");
@@ -1160,8 +1160,10 @@ fn augment_more_searches_the_library_and_pins_its_json() {
         .contains("one at a time"));
     // the model written carries every effect, in the blob and in `effects`
     let blob = std::fs::read(&out).unwrap();
-    let m = yawcast::model::Model::from_spec(&yawcast_shared::blob::decode_blob(&blob).unwrap())
-        .unwrap();
+    let m = yawcast::identify::model::Model::from_spec(
+        &yawcast_shared::blob::decode_blob(&blob).unwrap(),
+    )
+    .unwrap();
     let names: Vec<&str> = m.effects.iter().map(|e| e.kind().name()).collect();
     assert_eq!(v["effects"], serde_json::json!(names));
     assert!(

@@ -6,11 +6,11 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::Args;
 use serde::Serialize;
-use yawcast::augment::{self, AugmentConfig, AugmentError, AugmentReport, Written};
-use yawcast::data::Record;
 use yawcast::demo::FitSummary;
-use yawcast::export;
-use yawcast::model::Model;
+use yawcast::diagnose::augment::{self, AugmentConfig, AugmentError, AugmentReport, Written};
+use yawcast::identify::model::Model;
+use yawcast::io::data::Record;
+use yawcast::io::export;
 use yawcast::sim::{Ship, SimEffect};
 use yawcast_shared::model::EffectKind;
 
@@ -97,7 +97,7 @@ pub struct AugmentSummary {
     /// Ljung–Box p of the augmented model's.
     pub ljung_box_p_after: f64,
     /// The augmented model's effect with its estimated parameters.
-    pub estimated: Option<yawcast::model::Effect>,
+    pub estimated: Option<yawcast::identify::model::Effect>,
     /// STD% of the augmented model's parameters.
     pub std_pct: Vec<f64>,
     /// Physical words with numbers.
@@ -215,8 +215,8 @@ fn read_checked(read: &ReadArgs, paths: &[PathBuf], model: &Model) -> Result<Vec
 /// The library error as a CLI error: everything but a numerical failure is bad input.
 fn cli_err(e: AugmentError) -> anyhow::Error {
     match e {
-        AugmentError::Ident(yawcast::pem::IdentError::AllStartsFailed(_))
-        | AugmentError::Ident(yawcast::pem::IdentError::Unstable) => {
+        AugmentError::Ident(yawcast::identify::pem::IdentError::AllStartsFailed(_))
+        | AugmentError::Ident(yawcast::identify::pem::IdentError::Unstable) => {
             anyhow::Error::new(e).context("augment")
         }
         other => bad(other),
@@ -473,7 +473,7 @@ fn with_reference_gear(
         return given.clone();
     }
     let fit10 = |m: &Model| {
-        yawcast::merge::validation_fits(m, check)
+        yawcast::identify::merge::validation_fits(m, check)
             .get("10")
             .copied()
             .unwrap_or(f64::NAN)
@@ -542,7 +542,7 @@ fn choose_auto(
 /// units and writes it back atomically.
 fn write_ship(
     path: &Path,
-    effect: Option<&yawcast::model::Effect>,
+    effect: Option<&yawcast::identify::model::Effect>,
     model: &Model,
 ) -> Result<(Ship, SimEffect)> {
     let ship = if path.exists() {
@@ -564,7 +564,7 @@ fn write_ship(
     })?;
     let ship = ship.with_effect(se);
     let text = ship.to_toml_string().map_err(bad)?;
-    yawcast::data::write_atomic(path, text.as_bytes())
+    yawcast::io::data::write_atomic(path, text.as_bytes())
         .with_context(|| format!("writing the ship file {}", path.display()))?;
     Ok((ship, se))
 }
@@ -600,7 +600,7 @@ fn print_report(rep: &AugmentReport, secs: f64) {
         "horizon", "before", "baseline", "after"
     );
     let mut keys: Vec<&String> = rep.before.keys().collect();
-    keys.sort_by_key(|k| yawcast::predict::Horizon::parse(k));
+    keys.sort_by_key(|k| yawcast::identify::predict::Horizon::parse(k));
     for k in keys {
         let b = rep.before[k];
         println!(

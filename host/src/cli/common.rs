@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
-use yawcast::data::{self, Columns, Record};
-use yawcast::model::Model;
-use yawcast::nmea::{self, Clock, NmeaOptions};
+use yawcast::identify::model::Model;
+use yawcast::io::data::{self, Columns, Record};
+use yawcast::io::nmea::{self, Clock, NmeaOptions};
 use yawcast_shared::blob::FORMAT_VERSION;
 
 /// Marks an error as caused by the user's input (exit code 2).
@@ -27,7 +27,7 @@ pub fn is_bad_input(err: &anyhow::Error) -> bool {
         c.is::<BadInput>()
             || c.is::<data::DataError>()
             || c.is::<nmea::NmeaError>()
-            || c.is::<yawcast::model::ModelError>()
+            || c.is::<yawcast::identify::model::ModelError>()
             || c.is::<yawcast_shared::blob::BlobError>()
             || c.is::<yawcast_shared::model::ModelError>()
             || c.is::<serde_json::Error>()
@@ -338,10 +338,10 @@ fn model_from_json(bytes: &[u8], path: &Path) -> Result<Model> {
 }
 
 /// Parses `--horizons 1,5,10,20,sim`.
-pub fn parse_horizons(s: &str) -> Result<Vec<yawcast::predict::Horizon>> {
+pub fn parse_horizons(s: &str) -> Result<Vec<yawcast::identify::predict::Horizon>> {
     s.split(',')
         .map(|p| {
-            yawcast::predict::Horizon::parse(p).ok_or_else(|| {
+            yawcast::identify::predict::Horizon::parse(p).ok_or_else(|| {
                 bad(format!(
                     "--horizons: `{p}` is not a horizon (a whole number ≥ 1 or `sim`)"
                 ))

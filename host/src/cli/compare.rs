@@ -6,7 +6,7 @@ use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
 use std::collections::BTreeMap;
-use yawcast::predict::{self, Horizon};
+use yawcast::identify::predict::{self, Horizon};
 
 use super::common::{check_record_for_model, parse_horizons, read_model, JsonArg, ReadArgs};
 
@@ -107,7 +107,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
                 s.push('\n');
             }
             let p = dir.join(format!("{}.compare.csv", rec.name));
-            yawcast::data::write_atomic(&p, s.as_bytes())?;
+            yawcast::io::data::write_atomic(&p, s.as_bytes())?;
         }
         println!("series written to {}", dir.display());
     }

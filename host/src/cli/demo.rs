@@ -55,7 +55,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         Some(p) => return Err(bad(format!("--elf {}: no such file", p.display()))),
         None => std::env::current_dir()
             .ok()
-            .and_then(|ws| yawcast::hil::find_elf(&ws).ok()),
+            .and_then(|ws| yawcast::io::hil::find_elf(&ws).ok()),
     };
     let cfg = DemoConfig {
         seed,

@@ -7,10 +7,10 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::Args;
 use serde::Serialize;
-use yawcast::data::Record;
 use yawcast::demo::FitSummary;
 use yawcast::diagnose::{diagnose, DiagnoseConfig, Diagnosis, Ranked};
-use yawcast::model::Model;
+use yawcast::identify::model::Model;
+use yawcast::io::data::Record;
 
 use super::common::{bad, check_record_for_model, read_model, JsonArg, ReadArgs, SeedArg};
 
@@ -220,7 +220,7 @@ fn plot_evidence(d: &Diagnosis, path: &Path, alpha: f64) -> Result<()> {
             .label(format!("α = {alpha}"));
         root.present().map_err(plot_err)?;
     }
-    yawcast::data::write_atomic(path, svg.as_bytes())?;
+    yawcast::io::data::write_atomic(path, svg.as_bytes())?;
     Ok(())
 }
 
@@ -268,6 +268,6 @@ fn plot_fits(d: &Diagnosis, path: &Path) -> Result<()> {
         }
         root.present().map_err(plot_err)?;
     }
-    yawcast::data::write_atomic(path, svg.as_bytes())?;
+    yawcast::io::data::write_atomic(path, svg.as_bytes())?;
     Ok(())
 }

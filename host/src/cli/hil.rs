@@ -7,8 +7,8 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use clap::Args;
 use serde::Serialize;
-use yawcast::data::Record;
-use yawcast::hil::{self, Device, F32Record, LiveFit, NativePredictor};
+use yawcast::io::data::Record;
+use yawcast::io::hil::{self, Device, F32Record, LiveFit, NativePredictor};
 
 use super::common::{
     bad, check_record_for_model, progress, read_model, JsonArg, ReadArgs, SeedArg,

@@ -70,10 +70,10 @@ pub fn run(cli: Cli) -> Result<()> {
 /// (random switching intervals, several amplitudes) and the yaw rate the model itself
 /// produces, with gyro noise.
 pub fn sail(
-    model: &yawcast::model::Model,
+    model: &yawcast::identify::model::Model,
     steps: usize,
     seed: u64,
-) -> Result<yawcast::data::Record> {
+) -> Result<yawcast::io::data::Record> {
     use rand::{Rng, SeedableRng};
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     let mut u = Vec::with_capacity(steps);
@@ -88,11 +88,11 @@ pub fn sail(
         left -= 1;
         u.push(cur);
     }
-    let rec = yawcast::data::Record::from_uy("voyage", model.ts, u, vec![0.0; steps]);
-    let clean = yawcast::predict::simulate(model, &rec, &vec![0.0; model.n]);
+    let rec = yawcast::io::data::Record::from_uy("voyage", model.ts, u, vec![0.0; steps]);
+    let clean = yawcast::identify::predict::simulate(model, &rec, &vec![0.0; model.n]);
     let y = clean
         .iter()
         .map(|v| v + 0.01 * (rng.random::<f64>() - 0.5))
         .collect();
-    Ok(yawcast::data::Record { y, ..rec })
+    Ok(yawcast::io::data::Record { y, ..rec })
 }

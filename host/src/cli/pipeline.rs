@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
-use yawcast::data::Record;
-use yawcast::model::Model;
-use yawcast::{export, ga, merge, pem, tables};
+use yawcast::identify::model::Model;
+use yawcast::io::data::Record;
+use yawcast::{identify::merge, identify::pem, io::export, tune::ga, tune::tables};
 
 use super::common::{bad, read_model, JsonArg, ReadArgs, SeedArg};
 
@@ -283,7 +283,7 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
         merge::validation_fits(&model, &val)
     };
     if !fit.is_empty() {
-        let s: Vec<String> = yawcast::predict::Horizon::REPORT
+        let s: Vec<String> = yawcast::identify::predict::Horizon::REPORT
             .iter()
             .filter_map(|h| fit.get(&h.key()).map(|v| format!("{}: {v:.2} %", h.key())))
             .collect();

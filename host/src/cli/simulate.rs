@@ -187,7 +187,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         let recs = sim::simulate_many(&ship, &scenario, &seeds).map_err(bad)?;
         for (i, (rec, s)) in recs.iter().zip(&seeds).enumerate() {
             let path = numbered(out, i + 1, args.records);
-            yawcast::data::write_csv(&path, rec)
+            yawcast::io::data::write_csv(&path, rec)
                 .with_context(|| format!("writing {}", path.display()))?;
             println!(
                 "{}: {} samples at Ts = {} s, seed {s}",
@@ -209,7 +209,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     }
     if let Some(p) = &args.save_ship {
         let text = ship_out.to_toml_string().map_err(bad)?;
-        yawcast::data::write_atomic(p, text.as_bytes())
+        yawcast::io::data::write_atomic(p, text.as_bytes())
             .with_context(|| format!("writing the ship file {}", p.display()))?;
         println!("{}: ship file ({})", p.display(), ship_out.name);
     }

@@ -13,9 +13,9 @@ pub use run::{hidden_kind, run, DemoConfig, DemoError};
 
 use serde::Serialize;
 
-use crate::data::Record;
-use crate::model::Model;
-use crate::report::{Block, Cell, Line, Report, Section, Status};
+use crate::identify::model::Model;
+use crate::io::data::Record;
+use crate::io::report::{Block, Cell, Line, Report, Section, Status};
 
 /// Fit % keyed by horizon (`"1"`, `"5"`, `"10"`, `"20"`, `"sim"`).
 pub type Fits = BTreeMap<String, f64>;
@@ -928,7 +928,7 @@ impl Outcome {
 /// from the 10th on).
 ///
 /// # Errors
-/// [`crate::hil::HilError`] when the blob does not decode or the firmware refuses the
+/// [`crate::io::hil::HilError`] when the blob does not decode or the firmware refuses the
 /// model; a QEMU failure is reported in [`FirmwareCheck::qemu_note`], not as an error.
 pub fn firmware_check(
     model: &Model,
@@ -936,8 +936,8 @@ pub fn firmware_check(
     rec: &Record,
     elf: Option<&std::path::Path>,
     qemu_samples: usize,
-) -> Result<FirmwareCheck, crate::hil::HilError> {
-    use crate::hil::{self, compare_bits, native_run, F32Record};
+) -> Result<FirmwareCheck, crate::io::hil::HilError> {
+    use crate::io::hil::{self, compare_bits, native_run, F32Record};
     const H: usize = 20;
     const K: usize = 10;
     let spec_host = model
@@ -988,13 +988,13 @@ pub fn firmware_check(
         }
     };
     // f64 vs f32 at K steps, same (zero) initial state, from sample K on.
-    let host = crate::predict::k_step(model, rec, &vec![0.0; model.n], K);
+    let host = crate::identify::predict::k_step(model, rec, &vec![0.0; model.n], K);
     let mut fw = vec![f64::NAN; rec.len()];
     for t in K..rec.len() {
         fw[t] = f64::from(native[t - K][K - 1]);
     }
-    let fit_f64 = crate::predict::fit(&rec.y[K..], &host[K..]);
-    let fit_f32 = crate::predict::fit(&rec.y[K..], &fw[K..]);
+    let fit_f64 = crate::identify::predict::fit(&rec.y[K..], &host[K..]);
+    let fit_f32 = crate::identify::predict::fit(&rec.y[K..], &fw[K..]);
     let mut host_plot = host;
     for v in host_plot.iter_mut().take(K) {
         *v = f64::NAN;
@@ -1033,7 +1033,7 @@ pub fn effect_phrase(name: &str) -> &'static str {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::predict;
+    use crate::identify::predict;
 
     /// A synthetic outcome with every section filled, for layout tests.
     pub(crate) fn sample() -> Outcome {

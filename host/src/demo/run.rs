@@ -11,16 +11,16 @@ use thiserror::Error;
 use yawcast_shared::model::EffectKind;
 
 use super::{Evidence, FirmwareCheck, Fits, ModelResult, Outcome, Regime, Residuals};
-use crate::augment::{self, AugmentConfig};
-use crate::data::{self, Record};
+use crate::diagnose::augment::{self, AugmentConfig};
+use crate::diagnose::resid::{self, ResidConfig, ResidReport};
 use crate::diagnose::{self, DiagnoseConfig};
-use crate::ga::{self, GaConfig};
-use crate::merge;
-use crate::model::Model;
-use crate::pem::{self, PemConfig};
-use crate::predict::{self, Horizon};
-use crate::resid::{self, ResidConfig, ResidReport};
+use crate::identify::merge;
+use crate::identify::model::Model;
+use crate::identify::pem::{self, PemConfig};
+use crate::identify::predict::{self, Horizon};
+use crate::io::data::{self, Record};
 use crate::sim::{self, NoiseSpec, Scenario, Ship, SimEffect};
+use crate::tune::ga::{self, GaConfig};
 
 /// Settings of [`run`].
 #[derive(Debug, Clone)]
@@ -443,7 +443,7 @@ pub fn run(cfg: &DemoConfig, say: &mut dyn FnMut(&str)) -> Result<Outcome, DemoE
     write_twin(&cfg.out.join("conventional.json"), &conventional.model)?;
     write_twin(&cfg.out.join("tuned.json"), &tuned.model)?;
     let check = &val[0];
-    let exp = crate::export::export(&augmented.model, &cfg.out.join("model.postcard"), check)
+    let exp = crate::io::export::export(&augmented.model, &cfg.out.join("model.postcard"), check)
         .map_err(step("export"))?;
     let blob = std::fs::read(&exp.blob_path).map_err(|e| data::DataError::Io {
         path: exp.blob_path.clone(),

@@ -41,7 +41,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::data::Record;
+use crate::io::data::Record;
 
 mod dynamics;
 mod effects;

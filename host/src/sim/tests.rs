@@ -1,7 +1,7 @@
 //! Acceptance tests of the simulator: manoeuvres, effects, seeds, errors.
 
 use super::*;
-use crate::predict::{self, Horizon};
+use crate::identify::predict::{self, Horizon};
 use yawcast_shared::model::EffectKind;
 
 #[test]
@@ -99,9 +99,10 @@ fn hidden_effects_cost_a_linear_model_fit_or_show_in_the_channels() {
     let ship = Ship::default_lng();
     let sc = Scenario::default();
     let train = simulate_many(&ship, &sc, &[1, 2, 3]).unwrap();
-    let m = crate::pem::identify(&train, None, &crate::pem::PemConfig::default())
-        .unwrap()
-        .model;
+    let m =
+        crate::identify::pem::identify(&train, None, &crate::identify::pem::PemConfig::default())
+            .unwrap()
+            .model;
     // Slow effects (bias, gyro bias) show at long horizons: the Kalman gain re-anchors
     // short predictions.
     let fits = |sc: &Scenario| -> [f64; 2] {

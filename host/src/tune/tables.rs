@@ -15,11 +15,11 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::data::{self, Record};
-use crate::ga::GaReport;
-use crate::model::Model;
-use crate::pem::{self, reliability, Reliability};
-use crate::predict;
+use crate::identify::model::Model;
+use crate::identify::pem::{self, reliability, Reliability};
+use crate::identify::predict;
+use crate::io::data::{self, Record};
+use crate::tune::ga::GaReport;
 
 /// The paper's MPC reference: 80 % at 5 steps, 65 % at 10 steps.
 pub const MPC_REFERENCE: [(usize, f64); 2] = [(5, 80.0), (10, 65.0)];
@@ -279,7 +279,7 @@ impl Tables {
     /// The tables as Markdown.
     ///
     /// ```
-    /// use yawcast::{data::Record, model::Model, predict, tables::{Column, Tables}};
+    /// use yawcast::{io::data::Record, identify::model::Model, identify::predict, tune::tables::{Column, Tables}};
     /// let m = Model::new(1.0, vec![0.0, 0.5], vec![1.0, 0.5], vec![0.1, 0.0]).unwrap();
     /// let u: Vec<f64> = (0..200).map(|i| if i % 9 < 4 { 1.0 } else { -1.0 }).collect();
     /// let mut r = Record::from_uy("lake", 1.0, u, vec![0.0; 200]);
@@ -393,7 +393,7 @@ impl Tables {
     /// # Errors
     /// [`data::DataError::Io`] when a file cannot be written (the other is then removed).
     pub fn write(&self, out: &Path) -> Result<(PathBuf, PathBuf), data::DataError> {
-        let (blob, _) = crate::export::paths(out);
+        let (blob, _) = crate::io::export::paths(out);
         let stem = blob.with_extension("");
         let md = PathBuf::from(format!("{}.tables.md", stem.display()));
         let js = PathBuf::from(format!("{}.tables.json", stem.display()));
@@ -450,7 +450,7 @@ fn pp(v: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pem::{testdata, PemConfig};
+    use crate::identify::pem::{testdata, PemConfig};
 
     #[test]
     fn tables_in_the_papers_shape() {
@@ -526,7 +526,7 @@ mod tests {
         let a = testdata::truth();
         let b = a
             .clone()
-            .with_effect(crate::model::Effect::Bias { beta: 0.1 });
+            .with_effect(crate::identify::model::Effect::Bias { beta: 0.1 });
         let col = |m: &Model| Column {
             label: "x".into(),
             model: m.clone(),

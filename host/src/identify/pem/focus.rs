@@ -17,9 +17,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::{params_of, poly, with_params, IdentError};
-use crate::data::Record;
-use crate::model::Model;
-use crate::predict;
+use crate::identify::model::Model;
+use crate::identify::predict;
+use crate::io::data::Record;
 
 /// Settings of [`refine`].
 #[derive(Debug, Clone, PartialEq)]
@@ -114,12 +114,12 @@ fn stable(model: &Model, params: &[f64]) -> bool {
 /// measured sample.
 ///
 /// ```
-/// use yawcast::data::Record;
-/// use yawcast::model::Model;
-/// use yawcast::pem::focus::{refine, FocusConfig};
+/// use yawcast::io::data::Record;
+/// use yawcast::identify::model::Model;
+/// use yawcast::identify::pem::focus::{refine, FocusConfig};
 /// let m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.3, 0.1]).unwrap();
 /// let u: Vec<f64> = (0..300).map(|t| if (t / 9) % 2 == 0 { 1.0 } else { -1.0 }).collect();
-/// let y = yawcast::predict::simulate(&m, &Record::from_uy("r", 1.0, u.clone(), vec![0.0; 300]), &[0.0, 0.0]);
+/// let y = yawcast::identify::predict::simulate(&m, &Record::from_uy("r", 1.0, u.clone(), vec![0.0; 300]), &[0.0, 0.0]);
 /// let rec = Record::from_uy("r", 1.0, u, y);
 /// let cfg = FocusConfig { horizons: vec![1, 5], max_iter: 20, ..Default::default() };
 /// let r = refine(&[rec], &m, &cfg).unwrap();
@@ -251,15 +251,15 @@ pub fn refine(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pem::{identify, PemConfig};
-    use crate::predict::{fit_at, Horizon};
+    use crate::identify::pem::{identify, PemConfig};
+    use crate::identify::predict::{fit_at, Horizon};
 
     /// The built-in ship with a hidden 2 s actuator dead time, seen through a 4th-order model:
     /// the one-step optimum is not the best 10-step predictor, and the refinement must do
     /// better at 10 steps on a held-out record.
     #[test]
     fn focus_improves_long_horizon_prediction_of_a_misspecified_model() {
-        use crate::pem::testdata::ship_records;
+        use crate::identify::pem::testdata::ship_records;
         use yawcast_shared::model::EffectKind;
         let est = ship_records(EffectKind::DeadTime, &[1]);
         let val = ship_records(EffectKind::DeadTime, &[2]);

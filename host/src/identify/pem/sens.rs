@@ -1,14 +1,14 @@
 //! The one-step predictor and its exact parameter sensitivities.
 //!
-//! The forward pass is [`crate::predict::Stepper::step`] itself; alongside it runs the
+//! The forward pass is [`crate::identify::predict::Stepper::step`] itself; alongside it runs the
 //! derivative of every quantity of that step with respect to each estimated number (θ, the
 //! effect gains and x̂(0)), so the Jacobian is the exact derivative of what the predictor
 //! computes — including missing measurements (`y_used = ŷ`), effects that use `y` and an
 //! integrated heading.
 
-use crate::data::Record;
-use crate::model::{Effect, Model};
-use crate::predict::{Stepper, MAX_N};
+use crate::identify::model::{Effect, Model};
+use crate::identify::predict::{Stepper, MAX_N};
+use crate::io::data::Record;
 
 /// What one effect-gain column multiplies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -385,7 +385,7 @@ fn pass_n<const N: usize, S: Sink>(
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::predict;
+    use crate::identify::predict;
 
     /// Collects rows for Jacobian checks.
     #[derive(Default)]

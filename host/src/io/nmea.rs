@@ -44,7 +44,7 @@ use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
-use crate::data::Record;
+use crate::io::data::Record;
 
 /// Where sample times come from.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -179,7 +179,7 @@ pub enum NmeaError {
 /// XOR checksum of the characters between `$` and `*`.
 ///
 /// ```
-/// assert_eq!(yawcast::nmea::checksum("GPHDT,274.07,T"), 0x03);
+/// assert_eq!(yawcast::io::nmea::checksum("GPHDT,274.07,T"), 0x03);
 /// ```
 pub fn checksum(body: &str) -> u8 {
     body.bytes().fold(0, |c, b| c ^ b)
@@ -189,7 +189,7 @@ pub fn checksum(body: &str) -> u8 {
 /// before any comma).
 ///
 /// ```
-/// use yawcast::nmea::looks_like_nmea;
+/// use yawcast::io::nmea::looks_like_nmea;
 /// assert!(looks_like_nmea("\n$HEROT,1.0,A*2A\n"));
 /// assert!(!looks_like_nmea("t_s,delta_deg,r_degps\n"));
 /// ```
@@ -211,7 +211,7 @@ pub fn looks_like_nmea(text: &str) -> bool {
 /// A message when the rate is not a number or the status is not `A`/`V`.
 ///
 /// ```
-/// use yawcast::nmea::parse_rot;
+/// use yawcast::io::nmea::parse_rot;
 /// assert_eq!(parse_rot("-12.0,A"), Ok(Some(-0.2)));
 /// assert_eq!(parse_rot("3.0,V"), Ok(None));
 /// assert!(parse_rot("fast,A").is_err());
@@ -234,7 +234,7 @@ pub fn parse_rot(fields: &str) -> Result<Option<f64>, String> {
 /// A message when an angle is not a number or a status is not `A`/`V`.
 ///
 /// ```
-/// use yawcast::nmea::parse_rsa;
+/// use yawcast::io::nmea::parse_rsa;
 /// assert_eq!(parse_rsa("10.0,A,,V"), Ok(Some(10.0)));
 /// assert_eq!(parse_rsa("10.0,A,12.0,A"), Ok(Some(11.0)));
 /// assert_eq!(parse_rsa("10.0,V,,"), Ok(None));
@@ -266,7 +266,7 @@ pub fn parse_rsa(fields: &str) -> Result<Option<f64>, String> {
 /// A message when a number is malformed or a direction is not `E`/`W`.
 ///
 /// ```
-/// use yawcast::nmea::parse_hdg;
+/// use yawcast::io::nmea::parse_hdg;
 /// assert_eq!(parse_hdg("100.0,2.0,W,5.0,E"), Ok(Some(103.0)));
 /// assert_eq!(parse_hdg("100.0,,,,"), Ok(Some(100.0)));
 /// assert_eq!(parse_hdg(",,,,"), Ok(None));
@@ -366,7 +366,7 @@ pub fn read_nmea(path: &Path, opts: &NmeaOptions) -> Result<Record, NmeaError> {
 /// As [`read_nmea`].
 ///
 /// ```
-/// use yawcast::nmea::{parse_nmea, NmeaOptions, Clock};
+/// use yawcast::io::nmea::{parse_nmea, NmeaOptions, Clock};
 /// let log = "$HEROT,60.0,A*1D\n$IIRSA,5.0,A,,V*7C\n$HEROT,120.0,A*28\n$IIRSA,6.0,A,,V*7F\n\
 ///            $HEROT,60.0,A*1D\n$IIRSA,5.0,A,,V*7C\n";
 /// let opts = NmeaOptions { clock: Clock::Rate(2.0), ..NmeaOptions::default() };
@@ -842,9 +842,9 @@ fn interp(v: &[(f64, f64, usize)], grid: &[f64], angular: bool) -> Vec<f64> {
 mod tests {
     use super::*;
 
-    const TRIAL: &str = include_str!("../tests/data/trial.nmea");
-    const BAD: &str = include_str!("../tests/data/trial-bad-checksum.nmea");
-    const GAP: &str = include_str!("../tests/data/trial-gap.nmea");
+    const TRIAL: &str = include_str!("../../tests/data/trial.nmea");
+    const BAD: &str = include_str!("../../tests/data/trial-bad-checksum.nmea");
+    const GAP: &str = include_str!("../../tests/data/trial-gap.nmea");
 
     fn parse(text: &str, opts: &NmeaOptions) -> Result<Record, NmeaError> {
         parse_nmea(text, Path::new("trial.nmea"), "trial", opts)

@@ -4,10 +4,10 @@
 //!
 //! Horizons are k-step-ahead predictions (`"1"`, `"5"`, …) or pure simulation (`"sim"`), with
 //! x̂(0) estimated from each record by least squares on the one-step errors
-//! ([`crate::predict::estimate_x0`]).
+//! ([`crate::identify::predict::estimate_x0`]).
 //!
-//! The input checks shared by `compare`, [`crate::resid`], [`crate::diagnose`] and
-//! [`crate::augment`] live here too ([`check_inputs`], [`InputError`]).
+//! The input checks shared by `compare`, [`crate::diagnose::resid`], [`crate::diagnose`] and
+//! [`crate::diagnose::augment`] live here too ([`check_inputs`], [`InputError`]).
 
 use std::collections::BTreeMap;
 
@@ -15,9 +15,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::data::Record;
-use crate::model::{Model, ModelError};
-use crate::predict::{self, Horizon};
+use crate::identify::model::{Model, ModelError};
+use crate::identify::predict::{self, Horizon};
+use crate::io::data::Record;
 
 /// Why records or a model cannot be compared, diagnosed or augmented.
 #[derive(Debug, Error, PartialEq)]
@@ -94,7 +94,7 @@ pub enum InputError {
 /// [`InputError`] naming the record and channel at fault.
 ///
 /// ```
-/// use yawcast::{compare::{check_inputs, InputError}, data::Record, model::Model};
+/// use yawcast::{diagnose::compare::{check_inputs, InputError}, io::data::Record, identify::model::Model};
 /// let m = Model::new(0.5, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.3, 0.1]).unwrap();
 /// let r = Record::from_uy("trial", 1.0, vec![0.0; 50], vec![0.0; 50]);
 /// let e = check_inputs(&m, &[r], 20, "trial").unwrap_err();
@@ -234,7 +234,7 @@ fn rmse(y: &[f64], yhat: &[f64]) -> f64 {
 /// the model (sample time, channel lengths, non-finite samples, too short for the order).
 ///
 /// ```
-/// use yawcast::{compare::{compare, CompareConfig}, data::Record, model::Model, predict};
+/// use yawcast::{diagnose::compare::{compare, CompareConfig}, io::data::Record, identify::model::Model, identify::predict};
 /// let m = Model::new(1.0, vec![-0.3, 0.9], vec![0.5, 0.4], vec![0.0, 0.0]).unwrap();
 /// let u: Vec<f64> = (0..200).map(|i| if (i / 9) % 2 == 0 { 1.0 } else { -1.0 }).collect();
 /// let mut r = Record::from_uy("r", 1.0, u, vec![0.0; 200]);
@@ -341,7 +341,7 @@ impl CompareReport {
     /// out of range).
     ///
     /// ```
-    /// use yawcast::{compare::{compare, CompareConfig}, data::Record, model::Model};
+    /// use yawcast::{diagnose::compare::{compare, CompareConfig}, io::data::Record, identify::model::Model};
     /// let m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.3, 0.1]).unwrap();
     /// let r = Record::from_uy("r", 1.0, vec![1.0; 30], vec![0.5; 30]);
     /// let rep = compare(&m, &[r], &CompareConfig::default()).unwrap();

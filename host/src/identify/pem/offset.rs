@@ -33,9 +33,9 @@ use serde::Serialize;
 use yawcast_shared::model::EffectKind;
 
 use super::{identify_with, IdentError, PemConfig, PemReport};
-use crate::data::{block_mean, heading_bias, Record};
-use crate::model::{Effect, Model};
-use crate::predict;
+use crate::identify::model::{Effect, Model};
+use crate::identify::predict;
+use crate::io::data::{block_mean, heading_bias, Record};
 
 /// Why an offset effect was added.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -65,7 +65,7 @@ impl OffsetChoice {
     /// One line for the user.
     ///
     /// ```
-    /// use yawcast::pem::offset::OffsetChoice;
+    /// use yawcast::identify::pem::offset::OffsetChoice;
     /// let c = OffsetChoice { effect: "bias", value: 2.1, radius_without: 0.9999999,
     ///                        radius_with: 0.97, reason: "integrator", delta_bic: -812.0,
     ///                        heading_gyro_bias: Some([0.001, 0.002]) };
@@ -131,7 +131,7 @@ fn settles(model: &Model, recs: &[Record]) -> bool {
 /// effect only means the plain model stands).
 ///
 /// ```
-/// use yawcast::{data::Record, model::Model, pem, predict};
+/// use yawcast::{io::data::Record, identify::model::Model, identify::pem, identify::predict};
 /// // a 2nd-order ship without an offset: the plain model stands
 /// let truth = Model::new(1.0, vec![-0.5, 1.4], vec![0.1, 0.05], vec![0.3, 0.1]).unwrap();
 /// let u: Vec<f64> = (0..600).map(|i| if (i / 25) % 2 == 0 { 5.0 } else { -5.0 }).collect();
@@ -309,7 +309,7 @@ fn heading_term(rep: &PemReport, hb: Option<[f64; 2]>) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::predict;
+    use crate::identify::predict;
 
     fn record(truth: &Model, seed: usize) -> Record {
         // commands held 10–60 s at ±5, ±10, ±20°, deterministic per seed
@@ -345,7 +345,7 @@ mod tests {
 
     /// A slow 4th-order ship (poles 0.985, 0.9, 0.6 ± 0.2i).
     fn ship() -> Model {
-        let (a, b, k) = crate::model::from_difference_form(
+        let (a, b, k) = crate::identify::model::from_difference_form(
             &[-0.0003, -0.0242, -0.2935, -0.915],
             &[1.6e-4, 8e-5, 4e-5, 1.6e-5],
             &[0.0; 4],

@@ -16,8 +16,8 @@
 //! `x̂(t−k+1|t−k)` and runs k−1 open-loop steps (no measurements, `e = 0`, `y_used = ŷ`).
 //! The first k samples are pure simulation from `x̂(0)`.
 
-use crate::data::Record;
-use crate::model::{Effect, Model};
+use crate::identify::model::{Effect, Model};
+use crate::io::data::Record;
 
 /// Largest order handled (matches the shared schema).
 pub const MAX_N: usize = 8;
@@ -35,7 +35,7 @@ impl Horizon {
     /// The JSON/CLI key: `"5"` or `"sim"`.
     ///
     /// ```
-    /// use yawcast::predict::Horizon;
+    /// use yawcast::identify::predict::Horizon;
     /// assert_eq!(Horizon::Steps(5).key(), "5");
     /// assert_eq!(Horizon::Sim.key(), "sim");
     /// ```
@@ -49,7 +49,7 @@ impl Horizon {
     /// Parses `"5"` or `"sim"`; `None` for anything else (including 0).
     ///
     /// ```
-    /// use yawcast::predict::Horizon;
+    /// use yawcast::identify::predict::Horizon;
     /// assert_eq!(Horizon::parse("sim"), Some(Horizon::Sim));
     /// assert_eq!(Horizon::parse("10"), Some(Horizon::Steps(10)));
     /// assert_eq!(Horizon::parse("0"), None);
@@ -272,7 +272,7 @@ fn psi0(rec: &Record) -> f64 {
 /// One-step predictions ŷ(t|t−1) for every sample, from x̂(0) = `x0`.
 ///
 /// ```
-/// use yawcast::{data::Record, model::Model, predict};
+/// use yawcast::{io::data::Record, identify::model::Model, identify::predict};
 /// let m = Model::new(1.0, vec![0.0, 0.5], vec![1.0, 0.5], vec![0.0, 0.0]).unwrap();
 /// let r = Record::from_uy("x", 1.0, vec![1.0; 4], vec![0.0; 4]);
 /// // K = 0: pure simulation; x1(1) = b1·u = 1.
@@ -297,7 +297,7 @@ pub fn k_step(model: &Model, rec: &Record, x0: &[f64], k: usize) -> Vec<f64> {
 /// `max(horizons)` open-loop steps per sample instead of one per horizon.
 ///
 /// ```
-/// use yawcast::{data::Record, model::Model, predict};
+/// use yawcast::{io::data::Record, identify::model::Model, identify::predict};
 /// let m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.3, 0.1]).unwrap();
 /// let r = Record::from_uy("r", 1.0, vec![1.0, -1.0, 1.0, 1.0, -1.0], vec![0.0, 0.1, 0.0, 0.2, 0.1]);
 /// let all = predict::k_steps(&m, &r, &[0.0, 0.0], &[1, 3]);
@@ -359,7 +359,7 @@ pub fn predict(model: &Model, rec: &Record, x0: &[f64], h: Horizon) -> Vec<f64> 
 /// MATLAB `compare` fit: `100·(1 − ‖y − ŷ‖/‖y − mean(y)‖)`. Non-finite predictions give −∞.
 ///
 /// ```
-/// use yawcast::predict::fit;
+/// use yawcast::identify::predict::fit;
 /// assert_eq!(fit(&[1.0, 2.0, 3.0], &[1.0, 2.0, 3.0]), 100.0);
 /// assert_eq!(fit(&[1.0, 2.0, 3.0], &[2.0, 2.0, 2.0]), 0.0);
 /// ```
@@ -428,7 +428,7 @@ pub fn fit_at(model: &Model, rec: &Record, h: Horizon) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::Effect;
+    use crate::identify::model::Effect;
 
     fn m4() -> Model {
         Model::new(

@@ -3,7 +3,7 @@
 
 use super::testdata::{self, truth};
 use super::*;
-use crate::model::Effect;
+use crate::identify::model::Effect;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;

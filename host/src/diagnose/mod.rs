@@ -19,7 +19,7 @@
 //!   whichever gear effect mimics the gear's lag best on their commands stands out — a
 //!   2 s dead time on a ship whose own gear slews at 4 °/s looked like a slew limit of
 //!   5 °/s, and trials with no hidden effect showed a slew limit. So first the reference's
-//!   own gear dynamics are looked for with θ re-identified ([`crate::augment::forward`] over
+//!   own gear dynamics are looked for with θ re-identified ([`crate::diagnose::augment::forward`] over
 //!   dead time and slew limit on the reference records, its rule for keeping an effect);
 //!   when the reference shows some, every statistic below is measured against the reference
 //!   model with it (`base`), and a trial's departure from the reference's gear is tested as
@@ -53,7 +53,7 @@
 //!   a gyro bias, speed over ground for current and wind). An effect that speed over ground
 //!   alone shows (no heading-dependent yaw moment) and that buys no held-out yaw-rate
 //!   prediction is not named ahead of a significant effect that does. The verdict's effect
-//!   is then refitted with the model ([`crate::augment::augment`]) for the before/after fits.
+//!   is then refitted with the model ([`crate::diagnose::augment::augment`]) for the before/after fits.
 //! - **Current or wind.** A uniform current carries the ship: speed over ground varies with
 //!   heading by the current's speed (first harmonic), but the hull sees the same water
 //!   whatever its heading, so the current adds (almost) no heading-dependent yaw moment. Wind
@@ -67,6 +67,10 @@
 //! Effects already in the model are skipped, so diagnosing an augmented model looks for the
 //! next one.
 
+pub mod augment;
+pub mod compare;
+pub mod resid;
+
 use std::collections::BTreeMap;
 
 use nalgebra::{DMatrix, DVector};
@@ -76,13 +80,13 @@ use serde::Serialize;
 use thiserror::Error;
 use yawcast_shared::model::EffectKind;
 
-use crate::augment::{AugmentConfig, AugmentReport};
-use crate::compare::{check_inputs, mean_fit, InputError};
-use crate::data::Record;
-use crate::model::{Effect, Model};
-use crate::pem::{self, PemConfig};
-use crate::predict::{self, Horizon, Stepper};
-use crate::resid::{chi2_sf, normal_sf};
+use crate::diagnose::augment::{AugmentConfig, AugmentReport};
+use crate::diagnose::compare::{check_inputs, mean_fit, InputError};
+use crate::diagnose::resid::{chi2_sf, normal_sf};
+use crate::identify::model::{Effect, Model};
+use crate::identify::pem::{self, PemConfig};
+use crate::identify::predict::{self, Horizon, Stepper};
+use crate::io::data::Record;
 
 /// Horizon (samples) of the prediction errors the slow effects are fitted on.
 pub const SLOW_HORIZON: usize = 50;
@@ -100,7 +104,7 @@ pub struct DiagnoseConfig {
     pub null_reps: usize,
     /// Significance level (default 0.01).
     pub alpha: f64,
-    /// Refit the top candidate(s) with the effect ([`crate::augment::augment`]) and judge
+    /// Refit the top candidate(s) with the effect ([`crate::diagnose::augment::augment`]) and judge
     /// materiality on held-out records.
     pub confirm: bool,
     /// Settings of the confirming refit.
@@ -607,7 +611,7 @@ impl Null {
 // ---------------------------------------------------------------------------------------
 // channel statistics
 
-pub use crate::data::{heading_bias, HeadingBias};
+pub use crate::io::data::{heading_bias, HeadingBias};
 
 /// Coefficients of (sin ψ, cos ψ, sin 2ψ, cos 2ψ) in speed over ground; nuisance: one
 /// intercept per record and r² and δ² low-passed through each time constant of
@@ -810,7 +814,7 @@ struct Evidence {
 /// others have in a way that makes the comparison meaningless.
 ///
 /// ```
-/// use yawcast::{data::Record, diagnose::{diagnose, DiagnoseConfig}, model::Model};
+/// use yawcast::{io::data::Record, diagnose::{diagnose, DiagnoseConfig}, identify::model::Model};
 /// let m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.3, 0.1]).unwrap();
 /// let e = diagnose(&m, &[], &[], &[], &DiagnoseConfig::default()).unwrap_err();
 /// assert_eq!(e.to_string(), "no trial records given");
@@ -949,7 +953,7 @@ pub fn diagnose(
             if let Some(own) = base.effect(kind).filter(|_| gear.is_some()) {
                 e.words.push_str(&format!(
                     " (the reference's own: {})",
-                    crate::augment::describe(own, model.ts)
+                    crate::diagnose::augment::describe(own, model.ts)
                 ));
             }
             e
@@ -1023,7 +1027,8 @@ pub fn diagnose(
     }
     let verdict = verdict.map(|(i, frozen_fits)| {
         let report = if cfg.confirm {
-            crate::augment::augment(model, ev[i].kind, &est_part, &held_out, &cfg.augment).ok()
+            crate::diagnose::augment::augment(model, ev[i].kind, &est_part, &held_out, &cfg.augment)
+                .ok()
         } else {
             None
         };
@@ -1160,7 +1165,7 @@ struct RefActuator {
 }
 
 /// The reference's own steering-gear physics (module docs): forward selection over the
-/// actuator effects the model lacks, on the reference records, by [`crate::augment`]'s rule
+/// actuator effects the model lacks, on the reference records, by [`crate::diagnose::augment`]'s rule
 /// (re-identified, kept only when the held-out part of the reference pays for it or the
 /// reference supports it decisively). `None` when it keeps none.
 fn reference_actuator(
@@ -1176,7 +1181,7 @@ fn reference_actuator(
     if kinds.is_empty() {
         return None;
     }
-    let f = crate::augment::forward(model, reference, &[], &kinds, &cfg.augment).ok()?;
+    let f = crate::diagnose::augment::forward(model, reference, &[], &kinds, &cfg.augment).ok()?;
     if f.added.is_empty() || !f.model.is_stable() {
         return None;
     }
@@ -1184,7 +1189,7 @@ fn reference_actuator(
         .added
         .iter()
         .filter_map(|k| f.model.effect(*k))
-        .map(|e| crate::augment::describe(e, model.ts))
+        .map(|e| crate::diagnose::augment::describe(e, model.ts))
         .collect();
     let words = format!(
         " The reference records show steering-gear physics of their own that the linear \
@@ -1959,9 +1964,9 @@ mod tests {
     #[test]
     fn frozen_statistic_finds_a_known_dead_time() {
         // innovations data of a known model whose commands arrive 3 samples late
-        let truth = crate::pem::testdata::truth();
+        let truth = crate::identify::pem::testdata::truth();
         let mut rng = ChaCha8Rng::seed_from_u64(4);
-        let u = crate::pem::testdata::prbs(&mut rng, 1500, &[5.0, 10.0, 20.0]);
+        let u = crate::identify::pem::testdata::prbs(&mut rng, 1500, &[5.0, 10.0, 20.0]);
         let like = Record::from_uy("x", 1.0, u, vec![0.0; 1500]);
         let delayed = truth.clone().with_effect(Effect::DeadTime { samples: 3 });
         let rec = simulate_innovations(&delayed, &like, 0.02, &mut rng);

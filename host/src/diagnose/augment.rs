@@ -61,12 +61,12 @@ use serde::{Serialize, Serializer};
 use thiserror::Error;
 use yawcast_shared::model::EffectKind;
 
-use crate::compare::{check_inputs, InputError};
-use crate::data::Record;
-use crate::model::{Effect, Model};
-use crate::pem::{self, IdentError, PemConfig, PemReport};
-use crate::predict::{self, Horizon};
-use crate::resid;
+use crate::diagnose::compare::{check_inputs, InputError};
+use crate::diagnose::resid;
+use crate::identify::model::{Effect, Model};
+use crate::identify::pem::{self, IdentError, PemConfig, PemReport};
+use crate::identify::predict::{self, Horizon};
+use crate::io::data::Record;
 use crate::sim::{self, Scenario, Ship, SimEffect};
 
 /// Largest dead time tried (samples): the firmware's delay-line length.
@@ -276,7 +276,7 @@ fn evaluate(model: &Model, val: &[Record], horizons: &[Horizon], parallel: bool)
     };
     let per: Vec<_> = crate::par::map(val, parallel, one);
     let keys: Vec<String> = horizons.iter().map(Horizon::key).collect();
-    let mean = crate::compare::mean_fits(per.iter().map(|p| &p.0), &keys);
+    let mean = crate::diagnose::compare::mean_fits(per.iter().map(|p| &p.0), &keys);
     let finite = mean.values().all(|v| v.is_finite());
     let mut e = Eval {
         mean,
@@ -630,7 +630,7 @@ fn round_trips(m: &Model) -> bool {
 /// The effect in physical words (`ts`: the model's sample time, s).
 ///
 /// ```
-/// use yawcast::{augment::describe, model::Effect};
+/// use yawcast::{diagnose::augment::describe, identify::model::Effect};
 /// assert_eq!(describe(&Effect::RateLimit { rate: 3.14 }, 1.0), "a slew limit of 3.1 °/s");
 /// assert_eq!(
 ///     describe(&Effect::DeadTime { samples: 4 }, 0.5),
@@ -701,11 +701,11 @@ pub fn describe(effect: &Effect, ts: f64) -> String {
 /// reported as not kept.
 ///
 /// ```
-/// use yawcast::{augment::{augment, AugmentConfig}, data::Record, model::Model, predict};
+/// use yawcast::{diagnose::augment::{augment, AugmentConfig}, io::data::Record, identify::model::Model, identify::predict};
 /// use yawcast_shared::model::EffectKind;
 /// // a 2nd-order ship whose commands arrive two samples late
 /// let truth = Model::new(1.0, vec![-0.3, 0.9], vec![0.5, 0.4], vec![0.0, 0.0]).unwrap();
-/// let delayed = truth.clone().with_effect(yawcast::model::Effect::DeadTime { samples: 2 });
+/// let delayed = truth.clone().with_effect(yawcast::identify::model::Effect::DeadTime { samples: 2 });
 /// let rec = |seed: usize| {
 ///     let u: Vec<f64> = (0..400).map(|i| if ((i + seed) * 37 / 11) % 2 == 0 { 1.0 } else { -1.0 }).collect();
 ///     let mut r = Record::from_uy("r", 1.0, u, vec![0.0; 400]);
@@ -717,7 +717,7 @@ pub fn describe(effect: &Effect, ts: f64) -> String {
 ///                   &AugmentConfig::default()).unwrap();
 /// assert!(rep.kept);
 /// assert_eq!(rep.model.effect(EffectKind::DeadTime),
-///            Some(&yawcast::model::Effect::DeadTime { samples: 2 }));
+///            Some(&yawcast::identify::model::Effect::DeadTime { samples: 2 }));
 /// ```
 pub fn augment(
     model: &Model,
@@ -1123,7 +1123,7 @@ fn ser_kinds<S: Serializer>(k: &[EffectKind], s: S) -> Result<S::Ok, S::Error> {
 /// candidate that fails is reported as not kept.
 ///
 /// ```
-/// use yawcast::{augment::{forward, AugmentConfig}, data::Record, model::{Effect, Model}, predict};
+/// use yawcast::{diagnose::augment::{forward, AugmentConfig}, io::data::Record, identify::model::{Effect, Model}, identify::predict};
 /// use yawcast_shared::model::EffectKind;
 /// // a 2nd-order ship whose commands arrive two samples late
 /// let truth = Model::new(1.0, vec![-0.3, 0.9], vec![0.5, 0.4], vec![0.0, 0.0]).unwrap();
@@ -1365,7 +1365,7 @@ fn failed_report(
 ///   a second.
 ///
 /// ```
-/// use yawcast::{augment::to_sim_effect, model::{Effect, Model}, sim::{Ship, SimEffect}};
+/// use yawcast::{diagnose::augment::to_sim_effect, identify::model::{Effect, Model}, sim::{Ship, SimEffect}};
 /// let m = Model::new(1.0, vec![-0.3, 0.9], vec![0.5, 0.4], vec![0.0, 0.0]).unwrap();
 /// let e = to_sim_effect(&Effect::DeadTime { samples: 2 }, &m, &Ship::default_lng());
 /// assert_eq!(e, Some(SimEffect::DeadTime { delay_s: 2.0 }));
@@ -1778,7 +1778,7 @@ mod tests {
             let m = pem::identify(&sr, Some(&r.model), &PemConfig::default())
                 .unwrap()
                 .model;
-            crate::compare::mean_fit(&m, &trials, &[Horizon::Steps(10), Horizon::Sim])
+            crate::diagnose::compare::mean_fit(&m, &trials, &[Horizon::Steps(10), Horizon::Sim])
         };
         let (old, new) = (fit_from(&ship), fit_from(&with));
         assert!(new["sim"] > old["sim"] + 1.0, "{old:?} {new:?}");
@@ -1839,7 +1839,7 @@ mod tests {
             let m = pem::identify(&sr, None, &PemConfig::default())
                 .unwrap()
                 .model;
-            crate::compare::mean_fit(&m, &trials, &[Horizon::Steps(10)])["10"]
+            crate::diagnose::compare::mean_fit(&m, &trials, &[Horizon::Steps(10)])["10"]
         };
         let (old, new) = (fit_from(&ship), fit_from(&with));
         assert!(new > old + 10.0, "{old} → {new}");
@@ -2032,7 +2032,7 @@ mod tests {
     #[test]
     fn forward_selection_adds_nothing_to_a_linear_ship() {
         // records of a linear innovations model: no library effect pays for itself
-        use crate::pem::testdata::{record, truth};
+        use crate::identify::pem::testdata::{record, truth};
         let truth = truth();
         let est = [record(1, 1500), record(2, 1500)];
         let val = [record(3, 1500), record(4, 1500)];

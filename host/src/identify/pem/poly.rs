@@ -6,7 +6,7 @@
 
 use nalgebra::{Complex, DMatrix};
 
-use crate::predict::MAX_N;
+use crate::identify::predict::MAX_N;
 
 /// Coefficients of the characteristic polynomial of the companion matrix A:
 /// `zⁿ − a_n zⁿ⁻¹ − … − a_1`, written into `out[..=n]`.
@@ -117,7 +117,7 @@ fn f32_stable(a: &[f64], k: &[f64]) -> bool {
         return true;
     }
     // the blob carries the difference form (see the model schema)
-    let (g, _, kd) = crate::model::to_difference_form(a, &vec![0.0; n], k);
+    let (g, _, kd) = crate::identify::model::to_difference_form(a, &vec![0.0; n], k);
     let mut a32 = [0.0f32; MAX_ORDER];
     let mut k32 = [0.0f32; MAX_ORDER];
     for i in 0..n {
@@ -251,7 +251,7 @@ pub(crate) fn tf_to_canonical(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::Model;
+    use crate::identify::model::Model;
 
     #[test]
     fn predictor_poly_matches_eigenvalues() {
@@ -351,7 +351,7 @@ mod tests {
             let mut f64_ok = roots_within(&q, 4, MAX_RADIUS);
             predictor_poly(&a, &k, &mut q);
             f64_ok &= roots_within(&q, 4, MAX_RADIUS);
-            let (g, _, kd) = crate::model::to_difference_form(&a, &[0.0; 4], &k);
+            let (g, _, kd) = crate::identify::model::to_difference_form(&a, &[0.0; 4], &k);
             let g32: Vec<f32> = g.iter().map(|&v| v as f32).collect();
             let k32: Vec<f32> = kd.iter().map(|&v| v as f32).collect();
             let exportable =

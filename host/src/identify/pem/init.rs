@@ -4,9 +4,9 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::poly;
-use crate::data::Record;
-use crate::model::Model;
-use crate::predict::Stepper;
+use crate::identify::model::Model;
+use crate::identify::predict::Stepper;
+use crate::io::data::Record;
 
 /// The actuator output ũ of `template` over a record (θ plays no part in it).
 pub(crate) fn actuator_output(template: &Model, rec: &Record) -> Vec<f64> {

@@ -31,9 +31,9 @@ use yawcast_firmware::{Predictor, PredictorError, PredictorState};
 use yawcast_shared::blob::{self, FORMAT_VERSION, MAX_BLOB_LEN};
 use yawcast_shared::model::{ModelSpec, MAX_DEAD_TIME};
 
-use crate::data::{self, Record};
-use crate::model::Model;
-use crate::predict::{self, Horizon};
+use crate::identify::model::Model;
+use crate::identify::predict::{self, Horizon};
+use crate::io::data::{self, Record};
 
 /// Version of the JSON twin's layout.
 pub const JSON_FORMAT_VERSION: u32 = 1;
@@ -156,7 +156,7 @@ pub enum ExportError {
 ///
 /// ```
 /// use std::path::Path;
-/// let (b, j) = yawcast::export::paths(Path::new("runs/ship.postcard"));
+/// let (b, j) = yawcast::io::export::paths(Path::new("runs/ship.postcard"));
 /// assert_eq!(b, Path::new("runs/ship.postcard"));
 /// assert_eq!(j, Path::new("runs/ship.json"));
 /// ```
@@ -363,7 +363,7 @@ pub fn export_with(
     }
     let x0 = predict::estimate_x0(model, check);
     // the firmware's state is in the difference coordinates of the blob's model
-    let x0_fw = crate::model::differences(&x0);
+    let x0_fw = crate::identify::model::differences(&x0);
     let psi0 = check.psi.as_ref().map_or(0.0, |p| p[0]);
     let run = run_firmware(&spec_back, &x0_fw, psi0, check, hmax)?;
     let mut checks = Vec::new();
@@ -454,8 +454,8 @@ pub fn export_with(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::Effect;
-    use crate::pem::{self, testdata, PemConfig};
+    use crate::identify::model::Effect;
+    use crate::identify::pem::{self, testdata, PemConfig};
 
     fn tmpdir(name: &str) -> PathBuf {
         let d = std::env::temp_dir().join(format!("yawcast-export-{name}-{}", std::process::id()));

@@ -1,7 +1,7 @@
 //! The host's f64 model: canonical innovations form of order n plus library effects.
 //!
 //! Mirrors `yawcast_shared::model::ModelSpec` (the f32 export) with f64 numbers. The
-//! semantics of every effect are those of the firmware predictor; see [`crate::predict`].
+//! semantics of every effect are those of the firmware predictor; see [`crate::identify::predict`].
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
@@ -72,7 +72,7 @@ impl Effect {
     /// The effect's kind.
     ///
     /// ```
-    /// use yawcast::model::Effect;
+    /// use yawcast::identify::model::Effect;
     /// assert_eq!(Effect::Bias { beta: 1.0 }.kind().name(), "bias");
     /// ```
     pub fn kind(&self) -> EffectKind {
@@ -93,7 +93,7 @@ impl Effect {
     /// given structural parameter where one is needed (dead time samples, rate, limit).
     ///
     /// ```
-    /// use yawcast::model::Effect;
+    /// use yawcast::identify::model::Effect;
     /// use yawcast_shared::model::EffectKind;
     /// assert_eq!(Effect::zero(EffectKind::Current, 0.0), Effect::Current { beta_s: 0.0, beta_c: 0.0 });
     /// assert_eq!(Effect::zero(EffectKind::DeadTime, 2.0), Effect::DeadTime { samples: 2 });
@@ -128,7 +128,7 @@ impl Effect {
     /// The linear gains this effect adds to the parameter vector (empty for actuator effects).
     ///
     /// ```
-    /// use yawcast::model::Effect;
+    /// use yawcast::identify::model::Effect;
     /// assert_eq!(Effect::Current { beta_s: 1.0, beta_c: 2.0 }.gains(), vec![1.0, 2.0]);
     /// ```
     pub fn gains(&self) -> Vec<f64> {
@@ -301,7 +301,7 @@ impl Model {
     /// [`ModelError`] for a bad order, wrong lengths, non-finite numbers or `ts ≤ 0`.
     ///
     /// ```
-    /// use yawcast::model::Model;
+    /// use yawcast::identify::model::Model;
     /// let m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.3, 0.1]).unwrap();
     /// assert_eq!(m.n, 2);
     /// assert!(Model::new(1.0, vec![0.5], vec![0.1], vec![0.3]).is_err());
@@ -356,7 +356,7 @@ impl Model {
     /// θ = (a1..an, b1..bn, k1..kn).
     ///
     /// ```
-    /// use yawcast::model::Model;
+    /// use yawcast::identify::model::Model;
     /// let m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.3, 0.1]).unwrap();
     /// assert_eq!(m.theta(), vec![0.0, 0.5, 0.1, 0.2, 0.3, 0.1]);
     /// ```
@@ -379,7 +379,7 @@ impl Model {
     /// Parameter names in θ order followed by effect gains: `a1.., b1.., k1.., <effect>.<gain>`.
     ///
     /// ```
-    /// use yawcast::model::{Effect, Model};
+    /// use yawcast::identify::model::{Effect, Model};
     /// let mut m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.3, 0.1]).unwrap();
     /// m.effects.push(Effect::Bias { beta: 0.0 });
     /// assert_eq!(m.param_names().last().unwrap(), "bias.beta");
@@ -446,7 +446,7 @@ impl Model {
     /// polynomials' eigenvalues.
     ///
     /// ```
-    /// use yawcast::model::Model;
+    /// use yawcast::identify::model::Model;
     /// // x2' = 0.5 x1 ... companion with a = [0.25, 0]: eigenvalues ±0.5
     /// let m = Model::new(1.0, vec![0.25, 0.0], vec![0.0, 1.0], vec![0.0, 0.0]).unwrap();
     /// let (ra, rp) = m.spectral_radii();
@@ -496,7 +496,7 @@ impl Model {
     /// encoded.
     ///
     /// ```
-    /// use yawcast::model::Model;
+    /// use yawcast::identify::model::Model;
     /// // shift form z² − 0.5 z + 0.2 (a = (−0.2, 0.5)) is δ² + 1.5 δ + 0.7 in δ = z − 1
     /// let m = Model::new(1.0, vec![-0.2, 0.5], vec![0.1, 0.05], vec![0.3, 0.1]).unwrap();
     /// let s = m.to_spec().unwrap();
@@ -558,7 +558,7 @@ fn binomial(n: usize, k: usize) -> f64 {
 /// to the difference form.
 ///
 /// ```
-/// assert_eq!(yawcast::model::differences(&[1.0, 3.0, 7.0, 13.0]), vec![1.0, 2.0, 2.0, 0.0]);
+/// assert_eq!(yawcast::identify::model::differences(&[1.0, 3.0, 7.0, 13.0]), vec![1.0, 2.0, 2.0, 0.0]);
 /// ```
 pub fn differences(v: &[f64]) -> Vec<f64> {
     (0..v.len())
@@ -598,7 +598,7 @@ fn shift_poly(p: &[f64], s: f64) -> Vec<f64> {
 /// form in `f32`, where it keeps poles close to 1 that the shift form's coefficients lose.
 ///
 /// ```
-/// use yawcast::model::to_difference_form;
+/// use yawcast::identify::model::to_difference_form;
 /// // poles 0.9 and 0.5: z² − 1.4 z + 0.45 → δ² + 0.6 δ + 0.05
 /// let (g, b, k) = to_difference_form(&[-0.45, 1.4], &[1.0, 2.0], &[0.5, 0.25]);
 /// assert!((g[0] + 0.05).abs() < 1e-15 && (g[1] + 0.6).abs() < 1e-15);

@@ -111,7 +111,7 @@ impl Record {
     /// Number of samples.
     ///
     /// ```
-    /// let r = yawcast::data::Record::from_uy("x", 1.0, vec![0.0; 3], vec![0.0; 3]);
+    /// let r = yawcast::io::data::Record::from_uy("x", 1.0, vec![0.0; 3], vec![0.0; 3]);
     /// assert_eq!(r.len(), 3);
     /// ```
     pub fn len(&self) -> usize {
@@ -126,7 +126,7 @@ impl Record {
     /// A record with only input and output; time starts at 0.
     ///
     /// ```
-    /// let r = yawcast::data::Record::from_uy("x", 0.5, vec![1.0, 2.0], vec![0.0, 0.1]);
+    /// let r = yawcast::io::data::Record::from_uy("x", 0.5, vec![1.0, 2.0], vec![0.0, 0.1]);
     /// assert_eq!(r.t, vec![0.0, 0.5]);
     /// ```
     pub fn from_uy(name: &str, ts: f64, u: Vec<f64>, y: Vec<f64>) -> Record {
@@ -144,7 +144,7 @@ impl Record {
     /// Samples `start..end` as a new record (all channels).
     ///
     /// ```
-    /// let r = yawcast::data::Record::from_uy("x", 1.0, vec![1.0, 2.0, 3.0], vec![0.0; 3]);
+    /// let r = yawcast::io::data::Record::from_uy("x", 1.0, vec![1.0, 2.0, 3.0], vec![0.0; 3]);
     /// assert_eq!(r.slice(1, 3).u, vec![2.0, 3.0]);
     /// ```
     pub fn slice(&self, start: usize, end: usize) -> Record {
@@ -233,7 +233,7 @@ pub fn read_csv_with(path: &Path, cols: &Columns) -> Result<Record, DataError> {
 /// As [`read_csv`].
 ///
 /// ```
-/// use yawcast::data::{parse_csv, Columns};
+/// use yawcast::io::data::{parse_csv, Columns};
 /// let txt = "t_s,delta_deg,r_degps\n0,1,0\n1,1,0.5\n2,-1,0.2\n";
 /// let r = parse_csv(txt, "x.csv".as_ref(), "x", &Columns::default()).unwrap();
 /// assert_eq!(r.ts, 1.0);
@@ -329,7 +329,7 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
 /// seconds header: no yaw predictor samples that slowly). Empty when nothing looks wrong.
 ///
 /// ```
-/// use yawcast::data::{unit_warnings, Record};
+/// use yawcast::io::data::{unit_warnings, Record};
 /// let r = Record::from_uy("r", 1.0, vec![0.1, -0.2, 0.35], vec![0.001, 0.004, -0.002]);
 /// let w = unit_warnings(&r);
 /// assert_eq!(w.len(), 1);
@@ -373,7 +373,7 @@ pub fn unit_warnings(rec: &Record) -> Vec<String> {
 ///
 /// ```
 /// let mut psi = vec![358.0, 359.5, 0.5, 2.0, 1.0, 359.0];
-/// yawcast::data::unwrap_degrees(&mut psi);
+/// yawcast::io::data::unwrap_degrees(&mut psi);
 /// assert_eq!(psi, vec![358.0, 359.5, 360.5, 362.0, 361.0, 359.0]);
 /// ```
 pub fn unwrap_degrees(psi: &mut [f64]) {
@@ -405,9 +405,9 @@ pub fn unwrap_degrees(psi: &mut [f64]) {
 /// ```
 /// use std::path::Path;
 /// let t = [0.0, 1.01, 1.99, 3.0, 4.0, 5.0];
-/// assert_eq!(yawcast::data::check_uniform(&t, Path::new("x.csv")).unwrap(), 1.0);
+/// assert_eq!(yawcast::io::data::check_uniform(&t, Path::new("x.csv")).unwrap(), 1.0);
 /// let gap = [0.0, 1.0, 2.0, 4.0, 5.0];
-/// let e = yawcast::data::check_uniform(&gap, Path::new("x.csv")).unwrap_err();
+/// let e = yawcast::io::data::check_uniform(&gap, Path::new("x.csv")).unwrap_err();
 /// assert!(e.to_string().contains("row 4") && e.to_string().contains("1 sample missing"));
 /// ```
 pub fn check_uniform(t: &[f64], path: &Path) -> Result<f64, DataError> {
@@ -568,7 +568,7 @@ pub struct HeadingBias {
 /// record has no heading.
 ///
 /// ```
-/// use yawcast::data::{heading_bias, Record};
+/// use yawcast::io::data::{heading_bias, Record};
 /// // heading turns at 1 °/s, the gyro reads 1.2 °/s
 /// let mut r = Record::from_uy("x", 1.0, vec![0.0; 400], vec![1.2; 400]);
 /// r.psi = Some((0..400).map(|i| i as f64).collect());
@@ -603,7 +603,7 @@ pub fn heading_bias(recs: &[Record]) -> Option<HeadingBias> {
 /// let mut s = vec![0.0; 500];
 /// s.extend([1.0; 500]);
 /// s.push(f64::NAN); // a missing sample is skipped
-/// let (mean, se, n) = yawcast::data::block_mean(&[s]).unwrap();
+/// let (mean, se, n) = yawcast::io::data::block_mean(&[s]).unwrap();
 /// assert_eq!((mean, n), (0.5, 1000));
 /// assert!(se > 0.05, "{se}");
 /// ```

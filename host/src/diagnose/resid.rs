@@ -9,10 +9,10 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::compare::{check_inputs, InputError};
-use crate::data::Record;
-use crate::model::Model;
-use crate::predict::{self, Horizon};
+use crate::diagnose::compare::{check_inputs, InputError};
+use crate::identify::model::Model;
+use crate::identify::predict::{self, Horizon};
+use crate::io::data::Record;
 
 /// The 99 % two-sided normal quantile used by MATLAB's `resid` bands.
 pub const Z99: f64 = 2.58;
@@ -20,7 +20,7 @@ pub const Z99: f64 = 2.58;
 /// ln Γ(x) for x > 0 (Lanczos approximation, g = 7, 9 terms; relative error < 1e-14).
 ///
 /// ```
-/// use yawcast::resid::ln_gamma;
+/// use yawcast::diagnose::resid::ln_gamma;
 /// assert!((ln_gamma(5.0) - 24f64.ln()).abs() < 1e-12);
 /// assert!((ln_gamma(0.5) - std::f64::consts::PI.sqrt().ln()).abs() < 1e-12);
 /// ```
@@ -54,7 +54,7 @@ pub fn ln_gamma(x: f64) -> f64 {
 /// (series for x < a + 1, Lentz continued fraction otherwise). NaN for invalid arguments.
 ///
 /// ```
-/// use yawcast::resid::gamma_p;
+/// use yawcast::diagnose::resid::gamma_p;
 /// // P(1, x) = 1 − e^{−x}
 /// assert!((gamma_p(1.0, 2.0) - (1.0 - (-2.0f64).exp())).abs() < 1e-14);
 /// assert_eq!(gamma_p(3.0, 0.0), 0.0);
@@ -119,7 +119,7 @@ fn gamma_q_cf(a: f64, x: f64, lead: f64) -> f64 {
 /// χ² survival function P(X > x) with `df` degrees of freedom.
 ///
 /// ```
-/// use yawcast::resid::chi2_sf;
+/// use yawcast::diagnose::resid::chi2_sf;
 /// // 95 % quantile of χ²(1) is 3.841459
 /// assert!((chi2_sf(3.841_459, 1.0) - 0.05).abs() < 1e-6);
 /// // χ²(2) is exponential with mean 2
@@ -142,7 +142,7 @@ pub fn chi2_sf(x: f64, df: f64) -> f64 {
 /// Normal upper-tail probability P(Z > z) (erfc via the χ²(1) relation).
 ///
 /// ```
-/// use yawcast::resid::normal_sf;
+/// use yawcast::diagnose::resid::normal_sf;
 /// assert!((normal_sf(1.959_964) - 0.025).abs() < 1e-6);
 /// assert!((normal_sf(0.0) - 0.5).abs() < 1e-12);
 /// ```
@@ -186,7 +186,7 @@ fn pooled_cov(a: &[Vec<f64>], b: &[Vec<f64>], max_lag: usize) -> Vec<f64> {
 /// Normalised autocorrelation of `e` (pooled over records) at lags `0..=max_lag`.
 ///
 /// ```
-/// use yawcast::resid::acf;
+/// use yawcast::diagnose::resid::acf;
 /// let e = vec![vec![1.0, -1.0, 1.0, -1.0, 1.0, -1.0]];
 /// let r = acf(&e, 2);
 /// assert_eq!(r[0], 1.0);
@@ -207,7 +207,7 @@ pub fn acf(e: &[Vec<f64>], max_lag: usize) -> Vec<f64> {
 /// and its χ²(h) p-value.
 ///
 /// ```
-/// use yawcast::resid::ljung_box;
+/// use yawcast::diagnose::resid::ljung_box;
 /// let (q, p) = ljung_box(&[1.0, 0.0, 0.0], 100, 2);
 /// assert_eq!(q, 0.0);
 /// assert_eq!(p, 1.0);
@@ -364,7 +364,7 @@ pub struct ResidReport {
 /// `max(2·max_lag, 4·horizon)` samples.
 ///
 /// ```
-/// use yawcast::{data::Record, model::Model, predict, resid::{resid, ResidConfig}};
+/// use yawcast::{io::data::Record, identify::model::Model, identify::predict, diagnose::resid::{resid, ResidConfig}};
 /// let m = Model::new(1.0, vec![-0.3, 0.9], vec![0.5, 0.4], vec![0.2, 0.1]).unwrap();
 /// let u: Vec<f64> = (0..400).map(|i| if (i * 37 / 11) % 2 == 0 { 1.0 } else { -1.0 }).collect();
 /// let mut r = Record::from_uy("r", 1.0, u, vec![0.0; 400]);
@@ -777,7 +777,7 @@ fn describe_window(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::Effect;
+    use crate::identify::model::Effect;
     use rand::{Rng, SeedableRng};
 
     #[test]

@@ -7,7 +7,7 @@
 //! predicted value bit for bit.
 //!
 //! ```
-//! use yawcast::hil::NativePredictor;
+//! use yawcast::io::hil::NativePredictor;
 //! use yawcast_shared::model::{ModelSpec, Units};
 //! let m = ModelSpec::new(2, 1.0, &[-0.75, -1.5], &[0.5, -0.25], &[0.5, -0.375],
 //!                        Units::default(), &[]).unwrap();
@@ -32,7 +32,7 @@ use yawcast_shared::wire::{
     DeviceMessage, Feed, FrameAccumulator, FutureInputs, HostMessage, MAX_FRAME_LEN,
 };
 
-use crate::data::Record;
+use crate::io::data::Record;
 
 /// The thumb target of the firmware.
 pub const THUMB_TARGET: &str = "thumbv7em-none-eabihf";
@@ -638,7 +638,7 @@ impl LiveFit {
     /// Fit % per tracked horizon over the samples so far (NaN until there are enough).
     ///
     /// ```
-    /// use yawcast::hil::LiveFit;
+    /// use yawcast::io::hil::LiveFit;
     /// let mut f = LiveFit::new(&[1]);
     /// for t in 0..10 {
     ///     let y = t as f64;
@@ -661,7 +661,7 @@ impl LiveFit {
                 let f = if y.len() < 3 {
                     f64::NAN
                 } else {
-                    crate::predict::fit(&y, &yh)
+                    crate::identify::predict::fit(&y, &yh)
                 };
                 (k, f)
             })

@@ -3,7 +3,7 @@
 //! (text, tables, charts); [`Report::render`] turns it into HTML.
 //!
 //! ```
-//! use yawcast::report::{Block, Report, Section, Status};
+//! use yawcast::io::report::{Block, Report, Section, Status};
 //! let mut r = Report::new("Demo", "built-in ship", Status::Pass, "All good");
 //! r.sections.push(Section::new("fits", "Fits", "How well it predicts.")
 //!     .with(Block::bars("fit", "%", &["5"], &[("model", vec![91.0])])));
@@ -375,9 +375,9 @@ impl Report {
     /// Writes the page atomically.
     ///
     /// # Errors
-    /// [`crate::data::DataError::Io`] when the file cannot be written.
-    pub fn write(&self, path: &Path) -> Result<(), crate::data::DataError> {
-        crate::data::write_atomic(path, self.render().as_bytes())
+    /// [`crate::io::data::DataError::Io`] when the file cannot be written.
+    pub fn write(&self, path: &Path) -> Result<(), crate::io::data::DataError> {
+        crate::io::data::write_atomic(path, self.render().as_bytes())
     }
 }
 

@@ -5,9 +5,9 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::poly;
-use crate::data::Record;
-use crate::model::Model;
-use crate::predict::Stepper;
+use crate::identify::model::Model;
+use crate::identify::predict::Stepper;
+use crate::io::data::Record;
 
 /// The true model: A poles 0.95, 0.85, 0.6 ± 0.25i; predictor (C) roots 0.5, 0.3, −0.2, 0.1.
 pub(crate) fn truth() -> Model {

@@ -21,11 +21,11 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::data::Record;
-use crate::merge;
-use crate::model::Model;
-use crate::pem::{self, IdentError, PemConfig, PemReport};
-use crate::predict;
+use crate::identify::merge;
+use crate::identify::model::Model;
+use crate::identify::pem::{self, IdentError, PemConfig, PemReport};
+use crate::identify::predict;
+use crate::io::data::Record;
 
 /// How the models of several simulation records become one.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -263,7 +263,7 @@ pub enum GaError {
 /// Decodes a gene code into `[lo, hi]`.
 ///
 /// ```
-/// use yawcast::ga::decode;
+/// use yawcast::tune::ga::decode;
 /// assert_eq!(decode(0, 13, (1e-8, 100.0), false), 1e-8);
 /// assert_eq!(decode(8191, 13, (1e-8, 100.0), false), 100.0);
 /// assert!((decode(8191, 13, (1e-8, 100.0), true) - 100.0).abs() < 1e-9);
@@ -887,8 +887,8 @@ fn next_generation(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::Effect;
-    use crate::pem::testdata;
+    use crate::identify::model::Effect;
+    use crate::identify::pem::testdata;
 
     /// Synthetic "simulator": the known 4th-order model; trials add a rate limit on the
     /// pods (hidden) and more noise.

@@ -9,10 +9,10 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::data::Record;
-use crate::model::Model;
-use crate::pem::{self, IdentError, PemConfig, PemReport};
-use crate::predict::{self, Horizon};
+use crate::identify::model::Model;
+use crate::identify::pem::{self, IdentError, PemConfig, PemReport};
+use crate::identify::predict::{self, Horizon};
+use crate::io::data::Record;
 
 /// Errors combining models.
 #[derive(Debug, Clone, Error, PartialEq)]
@@ -88,7 +88,7 @@ fn same_structure(models: &[&Model]) -> Result<(), MergeError> {
 /// sample time or effects.
 ///
 /// ```
-/// use yawcast::{merge, model::Model};
+/// use yawcast::{identify::merge, identify::model::Model};
 /// let a = Model::new(1.0, vec![0.1, 0.5], vec![1.0, 2.0], vec![0.2, 0.1]).unwrap();
 /// let b = Model::new(1.0, vec![0.3, 0.3], vec![3.0, 2.0], vec![0.4, 0.1]).unwrap();
 /// let m = merge::average(&[a, b]).unwrap();
@@ -335,7 +335,7 @@ fn gamma_q(a: f64, x: f64) -> f64 {
 /// Survival function of the χ² distribution: `P(χ²_dof ≥ x)`.
 ///
 /// ```
-/// use yawcast::merge::chi2_sf;
+/// use yawcast::identify::merge::chi2_sf;
 /// assert!((chi2_sf(3.841458820694124, 1.0) - 0.05).abs() < 1e-9);
 /// assert!((chi2_sf(4.0, 2.0) - (-2.0f64).exp()).abs() < 1e-12);
 /// ```
@@ -376,7 +376,7 @@ pub struct CombineReport {
 /// Mean fit per report horizon over `records`.
 ///
 /// ```
-/// use yawcast::{data::Record, merge, model::Model, predict};
+/// use yawcast::{io::data::Record, identify::merge, identify::model::Model, identify::predict};
 /// let m = Model::new(1.0, vec![0.0, 0.5], vec![1.0, 0.5], vec![0.0, 0.0]).unwrap();
 /// let u: Vec<f64> = (0..50).map(|i| if i % 7 < 3 { 1.0 } else { -1.0 }).collect();
 /// let mut r = Record::from_uy("x", 1.0, u, vec![0.0; 50]);
@@ -516,8 +516,8 @@ pub fn compare(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::Effect;
-    use crate::pem::testdata;
+    use crate::identify::model::Effect;
+    use crate::identify::pem::testdata;
 
     #[test]
     fn chi2_survival_known_values() {

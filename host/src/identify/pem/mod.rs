@@ -3,7 +3,7 @@
 //!
 //! Cost: `V(θ) = (1/N) Σ ε(t,θ)² + (1/N) λ (θ−θ*)ᵀ R (θ−θ*)` over all samples of all records
 //! (θ* = 0 unless a nominal vector is given), minimised by Levenberg–Marquardt with the exact
-//! sensitivities of the one-step predictor ([`crate::predict::Stepper`]). θ holds (a, b, k)
+//! sensitivities of the one-step predictor ([`crate::identify::predict::Stepper`]). θ holds (a, b, k)
 //! and the linear gains of the template's effects; actuator effects (dead time, rate limit,
 //! saturation) stay as given. Each record has its own x̂(0), estimated jointly with θ (the
 //! initial states are eliminated from the normal equations, so they cost nothing extra).
@@ -30,9 +30,9 @@ use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::data::Record;
-use crate::model::Model;
-use crate::predict::{self, Horizon};
+use crate::identify::model::Model;
+use crate::identify::predict::{self, Horizon};
+use crate::io::data::Record;
 use sens::{Accum, Layout};
 
 pub(crate) use init::spd_solve;
@@ -118,7 +118,7 @@ impl Termination {
     /// Short description.
     ///
     /// ```
-    /// assert_eq!(yawcast::pem::Termination::MaxIterations.describe(), "iteration cap reached");
+    /// assert_eq!(yawcast::identify::pem::Termination::MaxIterations.describe(), "iteration cap reached");
     /// ```
     pub fn describe(&self) -> &'static str {
         match self {
@@ -145,7 +145,7 @@ pub enum Reliability {
 /// The paper's rule applied to a list of STD%s.
 ///
 /// ```
-/// use yawcast::pem::{reliability, Reliability};
+/// use yawcast::identify::pem::{reliability, Reliability};
 /// assert_eq!(reliability(&[1.0, 9.9]), Reliability::Reliable);
 /// assert_eq!(reliability(&[1.0, 27.7]), Reliability::Unreliable);
 /// assert_eq!(reliability(&[539.9, 2.0]), Reliability::Unusable);
@@ -822,7 +822,7 @@ fn spd_inverse(h: &DMatrix<f64>) -> DMatrix<f64> {
 /// start leads to a stable model.
 ///
 /// ```
-/// use yawcast::{data::Record, model::Model, pem, predict};
+/// use yawcast::{io::data::Record, identify::model::Model, identify::pem, identify::predict};
 /// // data from a known 2nd-order model, no noise
 /// let truth = Model::new(1.0, vec![-0.3, 0.9], vec![0.5, 0.4], vec![0.0, 0.0]).unwrap();
 /// let u: Vec<f64> = (0..300).map(|i| if (i * 37 / 11) % 2 == 0 { 1.0 } else { -1.0 }).collect();
@@ -920,7 +920,7 @@ pub(crate) fn identify_with(
 /// As [`identify`], and [`IdentError::StartUnstable`] when `start` is unstable.
 ///
 /// ```
-/// use yawcast::{data::Record, model::Model, pem, predict};
+/// use yawcast::{io::data::Record, identify::model::Model, identify::pem, identify::predict};
 /// let truth = Model::new(1.0, vec![-0.3, 0.9], vec![0.5, 0.4], vec![0.2, 0.1]).unwrap();
 /// let u: Vec<f64> = (0..300).map(|i| if (i * 37 / 11) % 2 == 0 { 1.0 } else { -1.0 }).collect();
 /// let mut rec = Record::from_uy("sim", 1.0, u, vec![0.0; 300]);

@@ -41,7 +41,7 @@ impl StartChoice {
     /// One line for the user.
     ///
     /// ```
-    /// use yawcast::pem::{choose::StartChoice, Start};
+    /// use yawcast::identify::pem::{choose::StartChoice, Start};
     /// let c = StartChoice {
     ///     lowest: Start::Arx,
     ///     cost_ratio: 1.013,
@@ -180,7 +180,7 @@ pub(crate) fn mse(errs: &[Vec<f64>]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pem::testdata::normal;
+    use crate::identify::pem::testdata::normal;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
