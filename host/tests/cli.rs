@@ -1344,3 +1344,153 @@ fn identify_focus_refines_on_k_step_errors_and_pins_its_json() {
     assert_eq!(code(&o), 2);
     assert!(stderr(&o).contains("--focus"), "{}", stderr(&o));
 }
+
+/// Records that cannot be right are refused before any work, with the file, row and column
+/// named, exit 2 and no output written: a corrupted cell (3.4e200, which once made
+/// `identify` run forever), a rudder angle of 2e6°, an all-zero trial, a yaw rate stuck at
+/// zero, a command that never moves, a duplicated column; and a `;`-separated file with
+/// decimal commas is read.
+#[test]
+fn implausible_or_still_records_are_refused_before_any_work() {
+    let d = scratch("plausible");
+    let good = csv_text(200, 0.5);
+    let mut lines: Vec<String> = good.lines().map(String::from).collect();
+    let cases: Vec<(&str, String, &str, &str)> = {
+        let mut corrupt = lines.clone();
+        corrupt[40] = format!("{},10,3.4e200", 39.0 * 0.5);
+        let mut rudder = lines.clone();
+        rudder[12] = format!("{},2000000,0.01", 11.0 * 0.5);
+        let zero: String = std::iter::once("t_s,delta_deg,r_degps".to_string())
+            .chain((0..200).map(|i| format!("{},0,0", f64::from(i) * 0.5)))
+            .collect::<Vec<_>>()
+            .join("\n");
+        let stuck: String = std::iter::once("t_s,delta_deg,r_degps".to_string())
+            .chain((0..200).map(|i| {
+                let u = if (i / 7) % 2 == 0 { 10 } else { -10 };
+                format!("{},{u},0", f64::from(i) * 0.5)
+            }))
+            .collect::<Vec<_>>()
+            .join("\n");
+        let mut dup = lines.clone();
+        dup[0] = "t_s,delta_deg,r_degps,r_degps".into();
+        for l in dup.iter_mut().skip(1) {
+            l.push_str(",0");
+        }
+        vec![
+            ("corrupt", corrupt.join("\n"), "row 40", "r_degps"),
+            ("rudder", rudder.join("\n"), "row 12", "delta_deg"),
+            ("zero", zero, "constant", "delta_deg"),
+            ("stuck", stuck, "constant", "r_degps"),
+            ("dup", dup.join("\n"), "more than once", "r_degps"),
+        ]
+    };
+    for (name, text, what, col) in &cases {
+        let f = d.join(format!("{name}.csv"));
+        std::fs::write(&f, text).unwrap();
+        let out = d.join(format!("{name}-model"));
+        let o = run(&[
+            "identify",
+            "--data",
+            f.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let e = stderr(&o);
+        assert_eq!(code(&o), 2, "{name}: {e}");
+        assert!(e.contains(&format!("{name}.csv")), "{name}: {e}");
+        assert!(e.contains(what) && e.contains(col), "{name}: {e}");
+        assert!(!out.with_extension("postcard").exists(), "{name}");
+        assert!(!out.with_extension("json").exists(), "{name}");
+    }
+    // The limit is the user's to raise (a positive number).
+    let m = write_model(&d);
+    let f = d.join("rudder.csv");
+    let o = run(&[
+        "compare",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        f.to_str().unwrap(),
+        "--max-angle",
+        "3e6",
+    ]);
+    // Read now, the 2e6° command drives the model's prediction far off: a numerical failure
+    // naming the record (exit 1), never a fit of −1e6 % printed as a result.
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("rudder.csv") && stderr(&o).contains("diverges"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!stdout(&o).contains("fit@"), "{}", stdout(&o));
+    let o = run(&[
+        "compare",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        f.to_str().unwrap(),
+        "--max-angle",
+        "-1",
+    ]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("--max-angle"), "{}", stderr(&o));
+    // A `;`-separated file with decimal commas reads as its comma twin.
+    lines[0] = "t_s;delta_deg;r_degps".into();
+    for l in lines.iter_mut().skip(1) {
+        *l = l.replace(',', ";").replace('.', ",");
+    }
+    std::fs::write(d.join("semi.csv"), lines.join("\n")).unwrap();
+    std::fs::write(d.join("comma.csv"), &good).unwrap();
+    let fits: Vec<String> = ["semi.csv", "comma.csv"]
+        .iter()
+        .map(|f| {
+            let o = run(&[
+                "compare",
+                "--model",
+                m.to_str().unwrap(),
+                "--data",
+                d.join(f).to_str().unwrap(),
+            ]);
+            assert_eq!(code(&o), 0, "{f}: {}", stderr(&o));
+            stdout(&o)
+                .lines()
+                .last()
+                .unwrap()
+                .split_whitespace()
+                .skip(1)
+                .collect()
+        })
+        .collect();
+    assert_eq!(fits[0], fits[1]);
+}
+
+/// A horizon as long as the record is bad input, named with the record, and nothing is written.
+#[test]
+fn compare_refuses_horizons_as_long_as_the_record() {
+    let d = scratch("diverge");
+    let m = write_model(&d);
+    let f = d.join("r.csv");
+    std::fs::write(&f, csv_text(200, 0.5)).unwrap();
+    let args = |h: &str| {
+        vec![
+            "compare".to_string(),
+            "--model".into(),
+            m.to_str().unwrap().into(),
+            "--data".into(),
+            f.to_str().unwrap().into(),
+            "--horizons".into(),
+            h.into(),
+            "--json".into(),
+            d.join("c.json").to_str().unwrap().into(),
+        ]
+    };
+    let argv = args("5000");
+    let o = run(&argv.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("r.csv") && stderr(&o).contains("5000"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!d.join("c.json").exists());
+}

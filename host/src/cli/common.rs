@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 use yawcast::identify::model::Model;
-use yawcast::io::data::{self, Columns, Record};
+use yawcast::io::data::{self, Columns, Limits, Record};
 use yawcast::io::nmea::{self, Clock, NmeaOptions};
 use yawcast_shared::blob::FORMAT_VERSION;
 
@@ -111,6 +111,15 @@ pub struct ReadArgs {
     /// NMEA logs: drop sentences with a bad checksum instead of failing.
     #[arg(long)]
     pub skip_bad_checksums: bool,
+    /// Largest plausible |commanded angle| (deg); a value beyond it is an error naming its row.
+    #[arg(long, value_name = "DEG", default_value_t = Limits::default().angle_deg)]
+    pub max_angle: f64,
+    /// Largest plausible |yaw rate| (deg/s); a value beyond it is an error naming its row.
+    #[arg(long, value_name = "DEGPS", default_value_t = Limits::default().rate_degps)]
+    pub max_rate: f64,
+    /// Largest plausible speed over ground or wind speed (m/s).
+    #[arg(long, value_name = "MPS", default_value_t = Limits::default().speed_mps)]
+    pub max_speed: f64,
 }
 
 impl Default for ReadArgs {
@@ -130,6 +139,9 @@ impl Default for ReadArgs {
             nmea_ts: None,
             max_gap: None,
             skip_bad_checksums: false,
+            max_angle: Limits::default().angle_deg,
+            max_rate: Limits::default().rate_degps,
+            max_speed: Limits::default().speed_mps,
         }
     }
 }
@@ -155,6 +167,26 @@ impl ReadArgs {
                 RateUnit::Radps => rad,
             },
         }
+    }
+
+    /// The plausibility limits.
+    ///
+    /// Errors when a limit is not a positive number (bad input).
+    pub fn limits(&self) -> Result<Limits> {
+        for (flag, v) in [
+            ("--max-angle", self.max_angle),
+            ("--max-rate", self.max_rate),
+            ("--max-speed", self.max_speed),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(bad(format!("{flag} {v}: expected a positive number")));
+            }
+        }
+        Ok(Limits {
+            angle_deg: self.max_angle,
+            rate_degps: self.max_rate,
+            speed_mps: self.max_speed,
+        })
     }
 
     /// The NMEA options.
@@ -190,11 +222,21 @@ impl ReadArgs {
                     || (ext != "csv" && nmea::looks_like_nmea(&text))
             }
         };
-        let rec = if is_nmea {
-            nmea::parse_nmea(&text, path, &name, &self.nmea())?
+        let (rec, cols) = if is_nmea {
+            let rec = nmea::parse_nmea(&text, path, &name, &self.nmea())?;
+            let cols = Columns {
+                u: "RSA rudder angle".into(),
+                y: "ROT rate of turn".into(),
+                speed: "VTG speed over ground".into(),
+                wind_speed: "MWV wind speed".into(),
+                ..Columns::default()
+            };
+            (rec, cols)
         } else {
-            data::parse_csv(&text, path, &name, &self.columns())?
+            let cols = self.columns();
+            (data::parse_csv(&text, path, &name, &cols)?, cols)
         };
+        data::validate_record(&rec, path, &self.limits()?, &cols)?;
         for w in data::unit_warnings(&rec) {
             eprintln!("warning: {}: {w}", path.display());
         }
@@ -237,7 +279,9 @@ pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<()> {
         .with_context(|| format!("writing the JSON summary {}", path.display()))
 }
 
-/// `--seed N`: the seed of every random choice; drawn and printed when not given.
+/// `--seed N`: the seed of every random choice; when not given, derived from the records
+/// (`tune`, `diagnose`, `augment`: the same records give the same result) or drawn from the
+/// clock (`demo`, `simulate`, `hil`), and printed.
 #[derive(Debug, Clone, Args)]
 pub struct SeedArg {
     /// Seed of every random choice (printed; the same seed gives the same result).
@@ -258,6 +302,45 @@ impl SeedArg {
         eprintln!("seed {seed} (rerun with --seed {seed} to repeat)");
         seed
     }
+
+    /// The seed to use for work on `records`: the given one, or one derived from the records'
+    /// contents (sample time and every channel), so that the same records give the same
+    /// result on every run. Printed on stderr with where it came from.
+    pub fn resolve_for(&self, records: &[&[Record]]) -> u64 {
+        if let Some(seed) = self.seed {
+            eprintln!("seed {seed} (given)");
+            return seed;
+        }
+        let seed = records_seed(records.iter().flat_map(|set| set.iter()));
+        eprintln!("seed {seed} (from the records; --seed N overrides)");
+        seed
+    }
+}
+
+/// A seed in `0..1_000_000` from the records' contents (FNV-1a over the bits of the sample
+/// time and of every sample of every channel, channel presence included).
+pub fn records_seed<'a>(records: impl Iterator<Item = &'a Record>) -> u64 {
+    const PRIME: u64 = 0x0000_0100_0000_01b3;
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |x: u64| {
+        for b in x.to_le_bytes() {
+            h ^= u64::from(b);
+            h = h.wrapping_mul(PRIME);
+        }
+    };
+    for r in records {
+        eat(r.ts.to_bits());
+        for ch in [Some(&r.u), Some(&r.y), r.psi.as_ref(), r.speed.as_ref()] {
+            match ch {
+                Some(v) => {
+                    eat(v.len() as u64);
+                    v.iter().for_each(|x| eat(x.to_bits()));
+                }
+                None => eat(u64::MAX),
+            }
+        }
+    }
+    h % 1_000_000
 }
 
 /// A progress bar on stderr (hidden when stderr is not a terminal).
@@ -350,6 +433,48 @@ pub fn parse_horizons(s: &str) -> Result<Vec<yawcast::identify::predict::Horizon
         .collect()
 }
 
+/// Checks that every k-step horizon is shorter than every record (a horizon as long as the
+/// record predicts nothing from measurements: ask for `sim` instead).
+pub fn check_horizons_fit(
+    horizons: &[yawcast::identify::predict::Horizon],
+    records: &[Record],
+    paths: &[PathBuf],
+) -> Result<()> {
+    for h in horizons {
+        let yawcast::identify::predict::Horizon::Steps(k) = *h else {
+            continue;
+        };
+        for (rec, p) in records.iter().zip(paths) {
+            if k >= rec.len() {
+                return Err(bad(format!(
+                    "{}: horizon {k} steps is not shorter than the record ({} samples); \
+                     use a shorter horizon, or `sim` for pure simulation",
+                    p.display(),
+                    rec.len()
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Smallest fit % reported as a result: below it the prediction error is more than 100 times
+/// the record's own spread, i.e. the prediction diverges (−∞ %, −1e58 %, …).
+pub const MIN_REPORTED_FIT: f64 = -1.0e4;
+
+/// Errors (exit 1, a numerical failure) when a fit is not finite or the prediction diverges,
+/// naming the record and horizon: such a number is never printed as a result.
+pub fn check_fit(fit: f64, horizon: &str, path: &Path) -> Result<()> {
+    if fit.is_finite() && fit >= MIN_REPORTED_FIT {
+        return Ok(());
+    }
+    Err(anyhow::anyhow!(
+        "{}: the model's prediction at horizon {horizon} diverges on this record (fit {fit:.3e} %): \
+         the model does not describe these data (another ship, sample time or unit?)",
+        path.display()
+    ))
+}
+
 /// Checks a record against a model (sample time, length).
 pub fn check_record_for_model(rec: &Record, model: &Model, path: &Path) -> Result<()> {
     let rel = (rec.ts - model.ts).abs() / model.ts;
@@ -372,4 +497,45 @@ pub fn check_record_for_model(rec: &Record, model: &Model, path: &Path) -> Resul
         )));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_seed_follows_the_records_not_the_clock() {
+        let a = Record::from_uy("a", 0.5, vec![1.0, -1.0, 2.0], vec![0.1, 0.2, 0.3]);
+        let mut b = a.clone();
+        let s = records_seed([&a].into_iter());
+        assert_eq!(s, records_seed([&a.clone()].into_iter()));
+        assert!(s < 1_000_000);
+        b.y[2] = 0.300_000_000_000_000_1;
+        assert_ne!(s, records_seed([&b].into_iter()));
+        b.y[2] = 0.3;
+        b.psi = Some(vec![0.0; 3]);
+        assert_ne!(s, records_seed([&b].into_iter()));
+        let arg = SeedArg { seed: None };
+        assert_eq!(arg.resolve_for(&[std::slice::from_ref(&a)]), s);
+        assert_eq!(SeedArg { seed: Some(7) }.resolve_for(&[&[a]]), 7);
+    }
+
+    #[test]
+    fn diverging_or_non_finite_fits_are_errors_naming_record_and_horizon() {
+        let p = Path::new("trials/t1.csv");
+        assert!(check_fit(93.5, "10", p).is_ok());
+        assert!(check_fit(-250.0, "sim", p).is_ok());
+        for bad_fit in [f64::NEG_INFINITY, f64::NAN, -1.9e58, MIN_REPORTED_FIT - 1.0] {
+            let e = check_fit(bad_fit, "sim", p).unwrap_err();
+            let msg = e.to_string();
+            assert!(
+                msg.contains("trials/t1.csv") && msg.contains("horizon sim"),
+                "{msg}"
+            );
+            assert!(
+                !is_bad_input(&e),
+                "a diverging prediction is a numerical failure (exit 1)"
+            );
+        }
+    }
 }

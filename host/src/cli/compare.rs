@@ -8,7 +8,14 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use yawcast::identify::predict::{self, Horizon};
 
-use super::common::{check_record_for_model, parse_horizons, read_model, JsonArg, ReadArgs};
+use super::common::{
+    check_fit, check_horizons_fit, check_record_for_model, parse_horizons, read_model, JsonArg,
+    ReadArgs,
+};
+
+/// The horizons compared when `--horizons` is not given (those not shorter than a record are
+/// left out with a note; horizons given explicitly must fit every record).
+const DEFAULT_HORIZONS: &str = "1,5,10,20,sim";
 
 /// Arguments of `yawcast compare`.
 #[derive(Debug, Args)]
@@ -20,7 +27,7 @@ pub struct CompareArgs {
     #[arg(long, value_name = "FILE", required = true)]
     pub data: Vec<PathBuf>,
     /// Horizons: whole numbers of steps and/or `sim` (pure simulation).
-    #[arg(long, value_name = "LIST", default_value = "1,5,10,20,sim")]
+    #[arg(long, value_name = "LIST", default_value = DEFAULT_HORIZONS)]
     pub horizons: String,
     /// Directory for the measured-vs-predicted series (one CSV per record).
     #[arg(long, value_name = "DIR")]
@@ -67,15 +74,35 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         check_record_for_model(&rec, &model, p)?;
         records.push(rec);
     }
+    let horizons = if args.horizons == DEFAULT_HORIZONS {
+        // The default horizons shrink to what short records can hold, with a word.
+        let shortest = records.iter().map(|r| r.len()).min().unwrap_or(0);
+        let (keep, drop): (Vec<Horizon>, Vec<Horizon>) = horizons
+            .into_iter()
+            .partition(|h| !matches!(h, Horizon::Steps(k) if *k >= shortest));
+        if !drop.is_empty() {
+            let keys: Vec<String> = drop.iter().map(Horizon::key).collect();
+            eprintln!(
+                "note: horizon(s) {} left out: not shorter than the shortest record ({shortest} samples)",
+                keys.join(", ")
+            );
+        }
+        keep
+    } else {
+        check_horizons_fit(&horizons, &records, &args.data)?;
+        horizons
+    };
     let mut out = Vec::new();
     let mut series = Vec::new();
-    for rec in &records {
+    for (rec, path) in records.iter().zip(&args.data) {
         let x0 = predict::estimate_x0(&model, rec);
         let mut fit = BTreeMap::new();
         let mut cols = Vec::new();
         for &h in &horizons {
             let yhat = predict::predict(&model, rec, &x0, h);
-            fit.insert(h.key(), predict::fit(&rec.y, &yhat));
+            let f = predict::fit(&rec.y, &yhat);
+            check_fit(f, &h.key(), path)?;
+            fit.insert(h.key(), f);
             cols.push((h, yhat));
         }
         series.push(cols);

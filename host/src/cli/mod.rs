@@ -15,7 +15,9 @@ pub mod simulate;
 /// yawcast — ship trials to a yaw-rate predictor that runs on the ship's controller.
 ///
 /// Exit codes: 0 success, 2 bad input (unreadable or invalid files, bad arguments, data
-/// errors), 1 any other failure. The first line of an error names its cause.
+/// errors), 1 any other failure. The first line of an error names its cause. Negative
+/// numbers are values wherever a number is expected (`--max-angle -1` is refused as a
+/// negative limit, not as an unknown flag).
 #[derive(Debug, Parser)]
 #[command(name = "yawcast", version, about, long_about = None, max_term_width = 100)]
 pub struct Cli {
@@ -29,24 +31,34 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Simulate records of the built-in (or your) ship: identification inputs, trials, manoeuvres.
+    #[command(allow_negative_numbers = true)]
     Simulate(simulate::SimulateArgs),
     /// Identify a model from records (prediction-error method), or select the order.
+    #[command(allow_negative_numbers = true)]
     Identify(pipeline::IdentifyArgs),
     /// Tune the regularisation (λ, R) with the genetic algorithm, scored on trial records.
+    #[command(allow_negative_numbers = true)]
     Tune(pipeline::TuneArgs),
     /// Combine several models: plain average, covariance-weighted merge, multi-record PEM.
+    #[command(allow_negative_numbers = true)]
     Average(pipeline::AverageArgs),
     /// Export a model as the firmware blob (+ JSON twin), checked through the firmware predictor.
+    #[command(allow_negative_numbers = true)]
     Export(pipeline::ExportArgs),
     /// Fit % of a model on records per horizon; measured vs predicted series.
+    #[command(allow_negative_numbers = true)]
     Compare(compare::CompareArgs),
     /// Which physical effect is missing from the model? Evidence for every effect, and a verdict.
+    #[command(allow_negative_numbers = true)]
     Diagnose(diagnose::DiagnoseArgs),
     /// Add an effect to a model, re-identify, and show the error before and after.
+    #[command(allow_negative_numbers = true)]
     Augment(augment::AugmentArgs),
     /// The whole story on the built-in ship with a hidden effect, ending in report.html.
+    #[command(allow_negative_numbers = true)]
     Demo(demo::DemoArgs),
     /// Hardware in the loop: the simulator sails, the firmware (QEMU or a board) predicts.
+    #[command(allow_negative_numbers = true)]
     Hil(hil::HilArgs),
 }
 

@@ -416,7 +416,7 @@ pub fn tune(args: &TuneArgs) -> Result<()> {
                 .ok_or_else(|| bad(format!("--horizons: `{h}` is not a whole number ≥ 1")))
         })
         .collect::<Result<_>>()?;
-    let seed = args.seed.resolve();
+    let seed = args.seed.resolve_for(&[&sim, &trials]);
     let mut cfg = ga::GaConfig {
         seed,
         max_generations: args.generations,

@@ -95,6 +95,52 @@ pub enum DataError {
         /// What the step means and what to do about it.
         what: String,
     },
+    /// Two columns share a name, so which one is meant cannot be told.
+    #[error(
+        "{path}: column `{column}` appears more than once in the header (columns {first} and \
+         {second}): rename one, or map the one you mean with the --col-* options"
+    )]
+    DuplicateColumn {
+        /// File concerned.
+        path: PathBuf,
+        /// The repeated name.
+        column: String,
+        /// 1-based position of its first appearance.
+        first: usize,
+        /// 1-based position of its second appearance.
+        second: usize,
+    },
+    /// A value is finite but beyond what the quantity can physically be.
+    #[error(
+        "{path}: row {row}, column `{column}`: {value} is beyond the plausible {limit} for {what} \
+         (a corrupted cell or another unit; raise the limit with {option} if it is real)"
+    )]
+    Implausible {
+        /// File concerned.
+        path: PathBuf,
+        /// 1-based data row (header is row 0).
+        row: usize,
+        /// Column name.
+        column: String,
+        /// The value found, in the record's units after scaling.
+        value: f64,
+        /// The limit (±).
+        limit: f64,
+        /// The quantity, in words.
+        what: &'static str,
+        /// The option that sets the limit.
+        option: &'static str,
+    },
+    /// A channel never moves, so nothing can be learnt from the record.
+    #[error("{path}: column `{column}` {what}")]
+    NoExcitation {
+        /// File concerned.
+        path: PathBuf,
+        /// Column name.
+        column: String,
+        /// What is wrong and what to do.
+        what: String,
+    },
     /// Too few samples to be of any use.
     #[error("{path}: {found} samples, at least {needed} needed")]
     TooShort {
@@ -244,9 +290,11 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
         path: path.to_path_buf(),
         message: e.to_string(),
     };
+    let semicolons = semicolon_separated(text);
     let mut rdr = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
+        .delimiter(if semicolons { b';' } else { b',' })
         .from_reader(text.as_bytes());
     let headers: Vec<String> = rdr
         .headers()
@@ -254,6 +302,16 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
         .iter()
         .map(|s| s.to_string())
         .collect();
+    for (j, h) in headers.iter().enumerate() {
+        if let Some(k) = headers[..j].iter().position(|g| g == h) {
+            return Err(DataError::DuplicateColumn {
+                path: path.to_path_buf(),
+                column: h.clone(),
+                first: k + 1,
+                second: j + 1,
+            });
+        }
+    }
     let find = |c: &str| headers.iter().position(|h| h == c);
     let need = |c: &str| {
         find(c).ok_or_else(|| DataError::MissingColumn {
@@ -282,7 +340,13 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
         let rown = i + 1;
         let cell = |idx: usize| -> Result<f64, DataError> {
             let s = row.get(idx).unwrap_or("");
-            match s.parse::<f64>() {
+            // A `;`-separated file writes decimals with a comma (`1,5`).
+            let parsed = if semicolons {
+                s.replace(',', ".").parse::<f64>()
+            } else {
+                s.parse::<f64>()
+            };
+            match parsed {
                 Ok(v) if v.is_finite() => Ok(v),
                 _ => Err(DataError::BadCell {
                     path: path.to_path_buf(),
@@ -320,6 +384,160 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
         unwrap_degrees(psi);
     }
     Ok(rec)
+}
+
+/// Whether the CSV text is `;`-separated (the spreadsheet export of locales with a decimal
+/// comma): its header has a `;` and no `,`.
+fn semicolon_separated(text: &str) -> bool {
+    let header = text
+        .lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty() && !l.starts_with('#'))
+        .unwrap_or("");
+    header.contains(';') && !header.contains(',')
+}
+
+/// Physical limits a record's values must respect (after unit scaling): a value beyond them
+/// is a corrupted cell or another unit, never a measurement to identify from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Limits {
+    /// Largest |commanded angle| (deg). Rudders and pods turn at most 35–45°, azimuth units 180°.
+    pub angle_deg: f64,
+    /// Largest |yaw rate| (deg/s).
+    pub rate_degps: f64,
+    /// Largest |speed over ground| and relative wind speed (m/s).
+    pub speed_mps: f64,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            angle_deg: 180.0,
+            rate_degps: 30.0,
+            speed_mps: 100.0,
+        }
+    }
+}
+
+/// Smallest span (max − min) of the command for a record to carry information (deg).
+pub const MIN_COMMAND_SPAN_DEG: f64 = 0.05;
+/// Smallest span of the yaw rate for a record to carry information (deg/s).
+pub const MIN_RATE_SPAN_DEGPS: f64 = 1e-3;
+
+/// Checks a record before any work is done on it: every value within `limits`, and both the
+/// command and the yaw rate moving (a command held at one angle, or a yaw rate stuck at one
+/// value, cannot be identified, tuned on, compared or diagnosed). `cols` names the columns
+/// in the messages; rows are 1-based samples of the record (for an NMEA log, of its grid).
+///
+/// # Errors
+/// [`DataError::Implausible`] naming the row and column of the first value beyond a limit,
+/// [`DataError::NoExcitation`] naming the column that never moves.
+///
+/// ```
+/// use yawcast::io::data::{validate_record, Columns, DataError, Limits, Record};
+/// let ok = Record::from_uy("r", 1.0, vec![0.0, 5.0, -5.0], vec![0.0, 0.4, -0.2]);
+/// assert!(validate_record(&ok, "r.csv".as_ref(), &Limits::default(), &Columns::default()).is_ok());
+/// let wild = Record::from_uy("r", 1.0, vec![0.0, 2e6, -5.0], vec![0.0, 0.4, -0.2]);
+/// let e = validate_record(&wild, "r.csv".as_ref(), &Limits::default(), &Columns::default());
+/// assert!(matches!(e, Err(DataError::Implausible { row: 2, .. })));
+/// let still = Record::from_uy("r", 1.0, vec![5.0; 3], vec![0.0, 0.4, -0.2]);
+/// let e = validate_record(&still, "r.csv".as_ref(), &Limits::default(), &Columns::default());
+/// assert!(matches!(e, Err(DataError::NoExcitation { .. })));
+/// ```
+pub fn validate_record(
+    rec: &Record,
+    path: &Path,
+    limits: &Limits,
+    cols: &Columns,
+) -> Result<(), DataError> {
+    let within =
+        |v: &[f64], col: &str, limit: f64, what: &'static str, option: &'static str| match v
+            .iter()
+            .position(|x| x.is_nan() || x.abs() > limit)
+        {
+            Some(i) => Err(DataError::Implausible {
+                path: path.to_path_buf(),
+                row: i + 1,
+                column: col.to_string(),
+                value: v[i],
+                limit,
+                what,
+                option,
+            }),
+            None => Ok(()),
+        };
+    within(
+        &rec.u,
+        &cols.u,
+        limits.angle_deg,
+        "a commanded angle (deg)",
+        "--max-angle",
+    )?;
+    within(
+        &rec.y,
+        &cols.y,
+        limits.rate_degps,
+        "a yaw rate (deg/s)",
+        "--max-rate",
+    )?;
+    if let Some(v) = &rec.speed {
+        within(
+            v,
+            &cols.speed,
+            limits.speed_mps,
+            "a speed (m/s)",
+            "--max-speed",
+        )?;
+    }
+    if let Some(v) = &rec.wind_speed {
+        within(
+            v,
+            &cols.wind_speed,
+            limits.speed_mps,
+            "a wind speed (m/s)",
+            "--max-speed",
+        )?;
+    }
+    let span = |v: &[f64]| {
+        let (lo, hi) = v
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| {
+                (l.min(x), h.max(x))
+            });
+        (hi - lo, lo, hi)
+    };
+    let still = |col: &str, v: &[f64], min: f64, unit: &str, why: &str| {
+        let (s, lo, hi) = span(v);
+        if s < min {
+            let held = if s == 0.0 {
+                format!("is constant ({lo} {unit} throughout)")
+            } else {
+                format!("is constant to within {s:.3e} {unit} ({lo} … {hi})")
+            };
+            return Err(DataError::NoExcitation {
+                path: path.to_path_buf(),
+                column: col.to_string(),
+                what: format!("{held}: {why}"),
+            });
+        }
+        Ok(())
+    };
+    still(
+        &cols.u,
+        &rec.u,
+        MIN_COMMAND_SPAN_DEG,
+        "deg",
+        "the command must move for the yaw dynamics to show; a record held at one angle \
+         cannot be identified, tuned on, compared or diagnosed",
+    )?;
+    still(
+        &cols.y,
+        &rec.y,
+        MIN_RATE_SPAN_DEGPS,
+        "deg/s",
+        "the yaw rate never moves; check that the rate sensor is logged, and its column and \
+         unit (--col-rate, --rate-unit)",
+    )
 }
 
 /// Warnings about the scale of a record's columns that suggest a unit mix-up: commands that
@@ -766,5 +984,68 @@ mod tests {
             .collect();
         assert!(leftovers.is_empty());
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn duplicate_columns_are_named_not_resolved() {
+        let e = parse("t_s,delta_deg,r_degps,delta_deg\n0,1,0,2\n1,2,1,3\n").unwrap_err();
+        assert!(
+            matches!(&e, DataError::DuplicateColumn { column, first: 2, second: 4, .. } if column == "delta_deg"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn semicolon_files_with_decimal_commas_are_read() {
+        let r = parse("t_s;delta_deg;r_degps\n0;1,5;0\n0,5;-2;0,25\n1;3;-0,125\n").unwrap();
+        assert_eq!(r.ts, 0.5);
+        assert_eq!(r.u, vec![1.5, -2.0, 3.0]);
+        assert_eq!(r.y, vec![0.0, 0.25, -0.125]);
+        // A comma file whose cells hold `;` stays a comma file (and fails on the cell).
+        assert!(!semicolon_separated("t_s,delta_deg;x,r_degps\n"));
+    }
+
+    #[test]
+    fn implausible_values_and_still_channels_are_named() {
+        let cols = Columns::default();
+        let lim = Limits::default();
+        let path = Path::new("trial.csv");
+        let mut r = Record::from_uy(
+            "r",
+            1.0,
+            vec![0.0, 4.0, -4.0, 2.0],
+            vec![0.0, 0.5, -0.5, 0.1],
+        );
+        assert!(validate_record(&r, path, &lim, &cols).is_ok());
+        r.y[2] = 3.4e200;
+        let e = validate_record(&r, path, &lim, &cols).unwrap_err();
+        assert!(
+            matches!(&e, DataError::Implausible { row: 3, column, limit, .. } if column == "r_degps" && *limit == 30.0),
+            "{e}"
+        );
+        assert!(e.to_string().contains("--max-rate"), "{e}");
+        r.y[2] = -0.5;
+        r.speed = Some(vec![1.0, 1.0, 150.0, 1.0]);
+        let e = validate_record(&r, path, &lim, &cols).unwrap_err();
+        assert!(matches!(e, DataError::Implausible { row: 3, .. }), "{e}");
+        r.speed = None;
+        let zero = Record::from_uy("z", 1.0, vec![0.0; 4], vec![0.0; 4]);
+        let e = validate_record(&zero, path, &lim, &cols).unwrap_err();
+        assert!(
+            matches!(&e, DataError::NoExcitation { column, .. } if column == "delta_deg"),
+            "{e}"
+        );
+        let tiny = Record::from_uy(
+            "t",
+            1.0,
+            vec![0.0, 5.0, 0.0, 5.0],
+            vec![1e-300, 0.0, 2e-300, 0.0],
+        );
+        let e = validate_record(&tiny, path, &lim, &cols).unwrap_err();
+        assert!(
+            matches!(&e, DataError::NoExcitation { column, .. } if column == "r_degps"),
+            "{e}"
+        );
+        assert!(e.to_string().contains("constant"), "{e}");
     }
 }
