@@ -20,7 +20,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
             // One line with the whole cause chain first, then nothing else to scroll past.
-            eprintln!("error: {err:#}");
+            eprintln!("error: {}", one_line(&err));
             if cli::common::is_bad_input(&err) {
                 ExitCode::from(2)
             } else {
@@ -28,4 +28,21 @@ fn main() -> ExitCode {
             }
         }
     }
+}
+
+/// The cause chain on one line, each cause once: an error whose text already holds its
+/// source's (`{path}: {source}`) is not followed by that source again.
+fn one_line(err: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in err.chain() {
+        let s = cause.to_string();
+        if line.contains(&s) {
+            continue;
+        }
+        if !line.is_empty() {
+            line.push_str(": ");
+        }
+        line.push_str(&s);
+    }
+    line
 }

@@ -1494,3 +1494,76 @@ fn compare_refuses_horizons_as_long_as_the_record() {
     );
     assert!(!d.join("c.json").exists());
 }
+
+/// `yawcast resid`: the residual tests as a table, JSON and plots; bad settings and short
+/// records are bad input; an output that cannot be written leaves none of the others.
+#[test]
+fn resid_reports_whiteness_and_writes_all_outputs_or_none() {
+    let d = scratch("resid");
+    let m = write_model(&d);
+    let f = d.join("r.csv");
+    std::fs::write(&f, csv_text(400, 0.5)).unwrap();
+    let (ms, fs) = (m.to_str().unwrap(), f.to_str().unwrap());
+    let json = d.join("resid.json");
+    let plots = d.join("plots");
+    let o = run(&[
+        "resid",
+        "--model",
+        ms,
+        "--data",
+        fs,
+        "--out",
+        plots.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(stdout(&o).contains("Ljung–Box"), "{}", stdout(&o));
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(v["acf"]["values"].as_array().unwrap().len(), 26);
+    assert_eq!(v["ccf"]["lags"].as_array().unwrap().len(), 51);
+    assert_eq!(v["samples"], 400);
+    let p = v["ljung_box"]["p_value"].as_f64().unwrap();
+    assert!((0.0..=1.0).contains(&p));
+    // The model is not the one that made the record: its residuals are far from white.
+    assert_eq!(v["white"], false);
+    assert!(p < 1e-6, "{p}");
+    assert!(plots.join("acf.svg").exists() && plots.join("ccf.svg").exists());
+
+    let o = run(&["resid", "--model", ms, "--data", fs, "--max-lag", "0"]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("--max-lag"), "{}", stderr(&o));
+    let short = d.join("short.csv");
+    std::fs::write(&short, csv_text(30, 0.5)).unwrap();
+    let o = run(&["resid", "--model", ms, "--data", short.to_str().unwrap()]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("short.csv"), "{}", stderr(&o));
+    // The JSON cannot be written (a directory stands there): no plot appears either.
+    let blocked = d.join("blocked.json");
+    std::fs::create_dir_all(&blocked).unwrap();
+    let plots2 = d.join("plots2");
+    let o = run(&[
+        "resid",
+        "--model",
+        ms,
+        "--data",
+        fs,
+        "--out",
+        plots2.to_str().unwrap(),
+        "--json",
+        blocked.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("blocked.json"), "{}", stderr(&o));
+    assert_eq!(
+        stderr(&o).matches("a directory stands").count(),
+        1,
+        "{}",
+        stderr(&o)
+    );
+    assert!(!plots2.join("acf.svg").exists());
+    let left: Vec<_> = std::fs::read_dir(&plots2)
+        .map(|it| it.flatten().map(|e| e.file_name()).collect())
+        .unwrap_or_default();
+    assert!(left.is_empty(), "{left:?}");
+}

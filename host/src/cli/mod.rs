@@ -10,6 +10,7 @@ pub mod demo;
 pub mod diagnose;
 pub mod hil;
 pub mod pipeline;
+pub mod resid;
 pub mod simulate;
 
 /// yawcast — ship trials to a yaw-rate predictor that runs on the ship's controller.
@@ -48,6 +49,10 @@ pub enum Command {
     /// Fit % of a model on records per horizon; measured vs predicted series.
     #[command(allow_negative_numbers = true)]
     Compare(compare::CompareArgs),
+    /// Residual tests (MATLAB `resid`): autocorrelation and input cross-correlation with
+    /// their bands, Ljung–Box, error by regime, worst windows.
+    #[command(allow_negative_numbers = true)]
+    Resid(resid::ResidArgs),
     /// Which physical effect is missing from the model? Evidence for every effect, and a verdict.
     #[command(allow_negative_numbers = true)]
     Diagnose(diagnose::DiagnoseArgs),
@@ -66,6 +71,7 @@ pub enum Command {
 pub fn run(cli: Cli) -> Result<()> {
     match &cli.command {
         Command::Compare(a) => compare::run(a),
+        Command::Resid(a) => resid::run(a),
         Command::Hil(a) => hil::run(a),
         Command::Identify(a) => pipeline::identify(a),
         Command::Tune(a) => pipeline::tune(a),

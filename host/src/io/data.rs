@@ -770,6 +770,80 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), DataError> {
     res.map_err(io)
 }
 
+/// Writes several files as one: every file goes to a temporary file beside its destination
+/// first, and only when all of them are written are they renamed into place. If any write
+/// fails, every temporary file is removed and no destination is touched: a command's outputs
+/// appear all together or not at all.
+///
+/// # Errors
+/// [`DataError::Io`] naming the first file that could not be written (or renamed).
+///
+/// ```
+/// use yawcast::io::data::write_all_atomic;
+/// let dir = std::env::temp_dir().join(format!("yawcast-doc-all-{}", std::process::id()));
+/// let ok = [(dir.join("a.txt"), b"a".to_vec()), (dir.join("b.txt"), b"b".to_vec())];
+/// write_all_atomic(&ok).unwrap();
+/// assert_eq!(std::fs::read(dir.join("b.txt")).unwrap(), b"b");
+/// // A destination that cannot be written (a directory stands there): nothing else appears.
+/// std::fs::create_dir_all(dir.join("c.txt")).unwrap();
+/// let bad = [(dir.join("new.txt"), b"n".to_vec()), (dir.join("c.txt"), b"c".to_vec())];
+/// assert!(write_all_atomic(&bad).is_err());
+/// assert!(!dir.join("new.txt").exists());
+/// # std::fs::remove_dir_all(&dir).unwrap();
+/// ```
+pub fn write_all_atomic(files: &[(PathBuf, Vec<u8>)]) -> Result<(), DataError> {
+    let tmp_of = |path: &Path| {
+        let fname = path
+            .file_name()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "out".into());
+        path.with_file_name(format!(".{fname}.tmp{}", std::process::id()))
+    };
+    let mut written: Vec<PathBuf> = Vec::new();
+    let cleanup = |written: &[PathBuf]| {
+        for t in written {
+            let _ = std::fs::remove_file(t);
+        }
+    };
+    for (path, bytes) in files {
+        let io = |source| DataError::Io {
+            path: path.clone(),
+            source,
+        };
+        if path.is_dir() {
+            cleanup(&written);
+            return Err(io(std::io::Error::other(
+                "a directory stands where the file should go",
+            )));
+        }
+        let tmp = tmp_of(path);
+        let res = (|| {
+            if let Some(d) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+                std::fs::create_dir_all(d)?;
+            }
+            let mut f = std::fs::File::create(&tmp)?;
+            f.write_all(bytes)?;
+            f.sync_all()
+        })();
+        if let Err(e) = res {
+            let _ = std::fs::remove_file(&tmp);
+            cleanup(&written);
+            return Err(io(e));
+        }
+        written.push(tmp);
+    }
+    for (i, (path, _)) in files.iter().enumerate() {
+        if let Err(source) = std::fs::rename(&written[i], path) {
+            cleanup(&written[i..]);
+            return Err(DataError::Io {
+                path: path.clone(),
+                source,
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Gyro-bias estimate from heading: `mean((r(t)+r(t+1))/2 − Δψ/Ts)` with its standard error
 /// from block sums. `None` without heading.
 #[derive(Debug, Clone, Copy, PartialEq)]
