@@ -99,6 +99,10 @@ pub struct ReadArgs {
     /// Unit of the CSV yaw-rate column.
     #[arg(long, value_enum, default_value = "degps")]
     pub rate_unit: RateUnit,
+    /// CSV: resample onto a uniform grid of this step (s) — command held, other channels
+    /// interpolated — instead of requiring uniform time stamps.
+    #[arg(long, value_name = "SECONDS")]
+    pub resample: Option<f64>,
     /// NMEA logs without a ZDA/RMC clock: the rate (Hz) at which ROT sentences arrive.
     #[arg(long, value_name = "HZ")]
     pub nmea_rate: Option<f64>,
@@ -139,6 +143,7 @@ impl Default for ReadArgs {
             nmea_ts: None,
             max_gap: None,
             skip_bad_checksums: false,
+            resample: None,
             max_angle: Limits::default().angle_deg,
             max_rate: Limits::default().rate_degps,
             max_speed: Limits::default().speed_mps,
@@ -166,6 +171,7 @@ impl ReadArgs {
                 RateUnit::Degps => 1.0,
                 RateUnit::Radps => rad,
             },
+            resample: self.resample,
         }
     }
 

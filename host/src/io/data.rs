@@ -230,6 +230,8 @@ pub struct Columns {
     pub angle_scale: f64,
     /// Multiply the yaw-rate column by this to get deg/s.
     pub rate_scale: f64,
+    /// Resample onto a uniform grid of this step (s) instead of requiring uniform time stamps.
+    pub resample: Option<f64>,
 }
 
 impl Default for Columns {
@@ -244,6 +246,7 @@ impl Default for Columns {
             wind_angle: "wind_angle_deg".into(),
             angle_scale: 1.0,
             rate_scale: 1.0,
+            resample: None,
         }
     }
 }
@@ -379,11 +382,104 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
             needed: 2,
         });
     }
-    rec.ts = check_uniform(&rec.t, path)?;
     if let Some(psi) = rec.psi.as_mut() {
         unwrap_degrees(psi);
     }
-    Ok(rec)
+    match cols.resample {
+        Some(dt) => resample(&rec, dt, path),
+        None => {
+            rec.ts = check_uniform(&rec.t, path)?;
+            Ok(rec)
+        }
+    }
+}
+
+/// Resamples a record onto the uniform grid `t_0, t_0 + dt, …` within its time span: the
+/// command zero-order held (it is held over each logged interval), every other channel
+/// linearly interpolated (heading and wind angle after unwrapping). The time stamps only need
+/// to increase; a logger's jitter, gaps and another rate are all absorbed.
+///
+/// # Errors
+/// [`DataError::NonUniform`] naming the first row whose time does not increase,
+/// [`DataError::TooShort`] when the grid holds fewer than 2 samples, and
+/// [`DataError::Csv`] when `dt` is not a positive number.
+///
+/// ```
+/// use yawcast::io::data::{resample, Record};
+/// let mut r = Record::from_uy("r", 0.0, vec![1.0, 2.0, 3.0], vec![0.0, 1.0, 3.0]);
+/// r.t = vec![0.0, 0.4, 1.1];
+/// let g = resample(&r, 0.5, "r.csv".as_ref()).unwrap();
+/// assert_eq!(g.t, vec![0.0, 0.5, 1.0]);
+/// assert_eq!(g.u, vec![1.0, 2.0, 2.0]);
+/// assert!((g.y[1] - (1.0 + 2.0 * 0.1 / 0.7)).abs() < 1e-12);
+/// assert_eq!(g.ts, 0.5);
+/// ```
+pub fn resample(rec: &Record, dt: f64, path: &Path) -> Result<Record, DataError> {
+    if !(dt.is_finite() && dt > 0.0) {
+        return Err(DataError::Csv {
+            path: path.to_path_buf(),
+            message: format!("--resample {dt}: expected a positive number of seconds"),
+        });
+    }
+    if let Some(i) = rec
+        .t
+        .windows(2)
+        .position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+    {
+        return Err(DataError::NonUniform {
+            path: path.to_path_buf(),
+            row: i + 2,
+            step: rec.t[i + 1] - rec.t[i],
+            expected: dt,
+            what: "time must increase from row to row, even when resampling".into(),
+        });
+    }
+    let (t0, t1) = (rec.t[0], rec.t[rec.t.len() - 1]);
+    let n = ((t1 - t0) / dt + 1e-9).floor() as usize + 1;
+    if n < 2 {
+        return Err(DataError::TooShort {
+            path: path.to_path_buf(),
+            found: n,
+            needed: 2,
+        });
+    }
+    let grid: Vec<f64> = (0..n).map(|k| t0 + k as f64 * dt).collect();
+    // For each grid time, the logged interval [t_j, t_{j+1}) that holds it and where in it.
+    let mut at = Vec::with_capacity(n);
+    let mut j = 0;
+    for &tg in &grid {
+        while j + 2 < rec.t.len() && rec.t[j + 1] <= tg {
+            j += 1;
+        }
+        let w = ((tg - rec.t[j]) / (rec.t[j + 1] - rec.t[j])).clamp(0.0, 1.0);
+        at.push((j, w));
+    }
+    let held = |v: &[f64]| -> Vec<f64> {
+        at.iter()
+            .map(|&(j, w)| if w >= 1.0 { v[j + 1] } else { v[j] })
+            .collect()
+    };
+    let linear = |v: &[f64]| -> Vec<f64> {
+        at.iter()
+            .map(|&(j, w)| v[j] + w * (v[j + 1] - v[j]))
+            .collect()
+    };
+    let unwrapped = |v: &[f64]| {
+        let mut v = v.to_vec();
+        unwrap_degrees(&mut v);
+        linear(&v)
+    };
+    Ok(Record {
+        name: rec.name.clone(),
+        ts: dt,
+        t: grid,
+        u: held(&rec.u),
+        y: linear(&rec.y),
+        psi: rec.psi.as_deref().map(unwrapped),
+        speed: rec.speed.as_deref().map(linear),
+        wind_speed: rec.wind_speed.as_deref().map(linear),
+        wind_angle: rec.wind_angle.as_deref().map(unwrapped),
+    })
 }
 
 /// Whether the CSV text is `;`-separated (the spreadsheet export of locales with a decimal
@@ -1121,5 +1217,27 @@ mod tests {
             "{e}"
         );
         assert!(e.to_string().contains("constant"), "{e}");
+    }
+
+    #[test]
+    fn resampling_absorbs_gaps_and_another_rate() {
+        // A 2 s gap that uniform reading refuses is resampled onto 0.5 s.
+        let txt = "t_s,delta_deg,r_degps,psi_deg\n0,1,0,358\n1,1,1,359\n3,-1,3,1\n4,-1,2,2\n";
+        assert!(parse(txt).is_err());
+        let cols = Columns {
+            resample: Some(0.5),
+            ..Columns::default()
+        };
+        let r = parse_csv(txt, "g.csv".as_ref(), "g", &cols).unwrap();
+        assert_eq!(r.ts, 0.5);
+        assert_eq!(r.t.len(), 9);
+        assert_eq!(r.u, vec![1.0, 1.0, 1.0, 1.0, 1.0, 1.0, -1.0, -1.0, -1.0]);
+        assert_eq!(r.y[3], 1.5);
+        assert_eq!(r.y[8], 2.0);
+        // Heading through north: 359 → 361 (unwrapped), half-way 360.
+        assert_eq!(r.psi.as_ref().unwrap()[4], 360.0);
+        let back = "t_s,delta_deg,r_degps\n0,1,0\n1,1,1\n1,2,2\n";
+        let e = parse_csv(back, "b.csv".as_ref(), "b", &cols).unwrap_err();
+        assert!(matches!(e, DataError::NonUniform { row: 3, .. }), "{e}");
     }
 }
