@@ -65,8 +65,8 @@ fn help_lists_every_subcommand() {
     assert_eq!(code(&o), 0);
     let out = stdout(&o);
     for c in [
-        "simulate", "identify", "tune", "average", "export", "compare", "diagnose", "augment",
-        "demo", "hil",
+        "simulate", "identify", "tune", "average", "export", "compare", "resid", "diagnose",
+        "augment", "demo", "hil",
     ] {
         assert!(
             out.lines().any(|l| l.trim_start().starts_with(c)),
@@ -1566,4 +1566,29 @@ fn resid_reports_whiteness_and_writes_all_outputs_or_none() {
         .map(|it| it.flatten().map(|e| e.file_name()).collect())
         .unwrap_or_default();
     assert!(left.is_empty(), "{left:?}");
+}
+
+/// Settings that cannot be honoured are bad input named before any work: a focus horizon
+/// longer than a quarter of a record, a hardware-in-the-loop run of no step, and a tuning
+/// record too short to score (found before the GA, not after it).
+#[test]
+fn settings_the_records_cannot_hold_are_refused_up_front() {
+    let d = scratch("settings");
+    let f = d.join("s.csv");
+    std::fs::write(&f, csv4(300, 1, 0.02)).unwrap();
+    let short = d.join("short.csv");
+    std::fs::write(&short, csv4(30, 2, 0.02)).unwrap();
+    let (fs, ss) = (f.to_str().unwrap(), short.to_str().unwrap());
+    let o = run(&["identify", "--data", fs, "--focus", "5000"]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("s.csv") && stderr(&o).contains("--focus 5000"));
+    let m = write_model(&d);
+    let o = run(&["hil", "--model", m.to_str().unwrap(), "--steps", "0"]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("--steps 0"), "{}", stderr(&o));
+    let o = run(&["tune", "--data", fs, "--validate", ss, "--seed", "1"]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("short.csv") && stderr(&o).contains("30 samples"));
+    // Refused on reading, before the starting model is identified.
+    assert!(!stderr(&o).contains("generation"), "{}", stderr(&o));
 }

@@ -79,6 +79,9 @@ pub fn run(args: &HilArgs) -> Result<()> {
             yawcast_shared::wire::MAX_HORIZON
         )));
     }
+    if args.steps == 0 {
+        return Err(bad("--steps 0: the loop needs at least one step"));
+    }
     let model = read_model(&args.model)?;
     let spec = model
         .to_spec()

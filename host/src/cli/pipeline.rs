@@ -185,6 +185,19 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
     let mut horizons = args.focus.clone();
     horizons.sort_unstable();
     horizons.dedup();
+    if let Some(&k) = horizons.last() {
+        // The focus criterion needs k-step errors over most of every record.
+        for (r, p) in recs.iter().zip(&args.data) {
+            if 4 * k > r.len() {
+                return Err(bad(format!(
+                    "{}: --focus {k} needs records of at least {} samples (4 × the horizon); this one has {}",
+                    p.display(),
+                    4 * k,
+                    r.len()
+                )));
+            }
+        }
+    }
     if let Some(o) = &args.orders {
         if !horizons.is_empty() {
             return Err(bad(
@@ -416,6 +429,34 @@ pub fn tune(args: &TuneArgs) -> Result<()> {
                 .ok_or_else(|| bad(format!("--horizons: `{h}` is not a whole number ≥ 1")))
         })
         .collect::<Result<_>>()?;
+    // Every record checked before the GA starts, not found wanting after it.
+    let kmax = horizons.iter().copied().max().unwrap_or(1);
+    let ts = sim[0].ts;
+    for (r, p) in sim
+        .iter()
+        .zip(&args.data)
+        .chain(trials.iter().zip(&args.validate))
+    {
+        if (r.ts - ts).abs() > 1e-6 * ts {
+            return Err(bad(format!(
+                "{}: sampled every {} s, {} every {ts} s; resample one of them (--resample)",
+                p.display(),
+                r.ts,
+                args.data[0].display()
+            )));
+        }
+    }
+    for (r, p) in trials.iter().zip(&args.validate) {
+        let needed = (4 * kmax).max(4 * args.order + 2);
+        if r.len() < needed {
+            return Err(bad(format!(
+                "{}: {} samples; scoring the {kmax}-step fit of an order-{} model needs at least {needed}",
+                p.display(),
+                r.len(),
+                args.order
+            )));
+        }
+    }
     let seed = args.seed.resolve_for(&[&sim, &trials]);
     let mut cfg = ga::GaConfig {
         seed,
