@@ -514,14 +514,31 @@ pub fn tune(args: &TuneArgs) -> Result<()> {
         centre_name(rep.centre),
         rep.best_fit
     );
+    if let Some(g) = &rep.gain {
+        println!(
+            "gain over the conventional model on the {} tuning records: {:+.3} ± {:.3} pp (mean ± standard error); {}",
+            g.records,
+            g.mean,
+            g.se,
+            if g.tuned_kept {
+                "the tuned model is kept"
+            } else {
+                "not above twice its standard error: the conventional model is kept"
+            }
+        );
+    }
     let tables = tables::Tables::from_ga(&rep, &trials).ok();
     if let Some(t) = &tables {
         println!("{}", t.to_markdown());
     }
     if let Some(out) = &args.out {
         let r = write_model(&rep.best_model, out, &trials[0])?;
+        let which = match &rep.gain {
+            Some(g) if !g.tuned_kept => "conventional",
+            _ => "tuned",
+        };
         println!(
-            "tuned model written to {} and {}",
+            "{which} model written to {} and {}",
             r.blob_path.display(),
             r.json_path.display()
         );
@@ -542,6 +559,7 @@ pub fn tune(args: &TuneArgs) -> Result<()> {
         "tuned": { "fit": rep.tuned.fits, "std_pct": rep.tuned.std_pct },
         "conventional": rep.conventional.as_ref().map(|c| serde_json::json!({ "fit": c.fits, "std_pct": c.std_pct })),
         "history": rep.history,
+        "gain": rep.gain,
     }))
 }
 

@@ -315,8 +315,13 @@ pub fn run(cfg: &DemoConfig, say: &mut dyn FnMut(&str)) -> Result<Outcome, DemoE
                 },
                 None => conventional_from(&conv_rep, val),
             };
+            let kept = rep.gain.as_ref().map_or(true, |g| g.tuned_kept);
             let tuned = ModelResult {
-                label: "GA-tuned".into(),
+                label: if kept {
+                    "GA-tuned".into()
+                } else {
+                    "GA-tuned (gain within its spread: conventional kept)".into()
+                },
                 fit: fits_of(&rep.best_model, val),
                 model: rep.best_model.clone(),
                 std_pct: rep.tuned.std_pct.clone(),
@@ -340,7 +345,18 @@ pub fn run(cfg: &DemoConfig, say: &mut dyn FnMut(&str)) -> Result<Outcome, DemoE
                 rep.r.iter().map(|v| format!("{v:.3e}")).collect::<Vec<_>>().join(", "),
                 rep.best_fit,
                 est.len()
-            );
+            ) + &rep.gain.as_ref().map_or(String::new(), |g| {
+                format!(
+                    "; gain over the conventional model {:+.2} ± {:.2} pp record by record — {}",
+                    g.mean,
+                    g.se,
+                    if g.tuned_kept {
+                        "the tuned model goes on"
+                    } else {
+                        "within its spread, so the conventional model goes on"
+                    }
+                )
+            });
             (conv, tuned, note)
         }
         Err(e) => {

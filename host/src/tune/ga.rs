@@ -184,7 +184,10 @@ pub struct Scored {
 /// Result of [`tune`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GaReport {
-    /// The best (tuned) model.
+    /// The model to use: the GA's best candidate when its gain over the conventional model
+    /// on the tuning trials is above its spread ([`GaReport::gain`]), else the conventional
+    /// model (then `lambda`, `r` and `genes` are zero and [`GaReport::tuned`] still shows
+    /// the GA's candidate).
     pub best_model: Model,
     /// Its λ.
     pub lambda: f64,
@@ -215,6 +218,29 @@ pub struct GaReport {
     pub termination: GaTermination,
     /// The seed.
     pub seed: u64,
+    /// The GA's gain over the conventional model on the tuning trials, record by record, and
+    /// whether it is large enough to keep the tuned model; `None` without a conventional model.
+    #[serde(default)]
+    pub gain: Option<TuningGain>,
+}
+
+/// The tuned model's gain over the conventional one on the tuning trials: per record, the
+/// tuned minus the conventional fitness (mean k-step fit %), averaged.
+///
+/// The GA picks the best of many candidates on these very records, so a gain that is not
+/// larger than its own spread is what picking the best of many noisy scores gives by chance:
+/// then the conventional model is kept ([`GaReport::best_model`]), and the output says so.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TuningGain {
+    /// Mean gain over the trial records (percentage points).
+    pub mean: f64,
+    /// Its standard error (pp; 0 with one record).
+    pub se: f64,
+    /// Trial records.
+    pub records: usize,
+    /// Whether the tuned model is kept: the mean gain is positive and above twice its
+    /// standard error (with one record, above zero).
+    pub tuned_kept: bool,
 }
 
 /// GA errors.
@@ -599,7 +625,7 @@ pub fn tune_with(
         }
     }
     if cfg.centres.len() < 2 {
-        return tune_one(sim, trials, base, cfg, on_generation);
+        return tune_one(sim, trials, base, cfg, on_generation).map(|r| settle(r, trials, cfg));
     }
     let mut best: Option<GaReport> = None;
     let mut first_err = None;
@@ -620,7 +646,55 @@ pub fn tune_with(
             }
         }
     }
-    best.ok_or_else(|| first_err.unwrap_or(GaError::NoSimulation))
+    best.map(|r| settle(r, trials, cfg))
+        .ok_or_else(|| first_err.unwrap_or(GaError::NoSimulation))
+}
+
+/// Keeps the tuned model only when its gain over the conventional one on the tuning trials
+/// is above its spread ([`TuningGain`]); otherwise the conventional model is the result
+/// (`λ = 0`, `R = 0`, the conventional genes), and [`GaReport::tuned`] still shows what the
+/// GA found.
+fn settle(mut rep: GaReport, trials: &[Record], cfg: &GaConfig) -> GaReport {
+    let Some(conv) = rep.conventional.clone() else {
+        return rep;
+    };
+    let per_record = |m: &Model| -> Vec<f64> {
+        trials
+            .iter()
+            .map(|r| {
+                let f = trial_fits(m, std::slice::from_ref(r), &cfg.horizons);
+                f.values().sum::<f64>() / f.len().max(1) as f64
+            })
+            .collect()
+    };
+    let d: Vec<f64> = per_record(&rep.best_model)
+        .iter()
+        .zip(per_record(&conv.model))
+        .map(|(t, c)| t - c)
+        .collect();
+    let n = d.len();
+    let mean = d.iter().sum::<f64>() / n.max(1) as f64;
+    let se = if n > 1 {
+        let var = d.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1) as f64;
+        (var / n as f64).sqrt()
+    } else {
+        0.0
+    };
+    let tuned_kept = mean.is_finite() && mean > 0.0 && mean > 2.0 * se;
+    if !tuned_kept {
+        rep.best_model = conv.model.clone();
+        rep.best_fit = conv.fitness;
+        rep.lambda = 0.0;
+        rep.r = vec![0.0; rep.r.len()];
+        rep.genes = vec![0; rep.genes.len()];
+    }
+    rep.gain = Some(TuningGain {
+        mean,
+        se,
+        records: n,
+        tuned_kept,
+    });
+    rep
 }
 
 /// One GA run around one penalty centre (`cfg.centres[0]`, else `cfg.pem.nominal`).
@@ -783,6 +857,7 @@ fn tune_one(
         rejected_by,
         termination,
         seed: cfg.seed,
+        gain: None,
     })
 }
 
@@ -1107,5 +1182,48 @@ mod tests {
         );
         let again = tune(&sim, &trials, &b, &cfg).unwrap();
         assert_eq!(again.best_model, rep.best_model);
+        // A real gain, record by record: the tuned model is the one to use.
+        let g = rep.gain.as_ref().unwrap();
+        assert!(g.tuned_kept && g.mean > 2.0 * g.se, "{g:?}");
+        assert_eq!(rep.best_model, rep.tuned.model);
+    }
+
+    #[test]
+    fn a_gain_within_its_spread_keeps_the_conventional_model() {
+        let (sim, trials) = scenario(3, 400);
+        let b = base(&sim);
+        let cfg = GaConfig {
+            max_generations: 2,
+            progress: false,
+            seed: 3,
+            std_limit: f64::INFINITY,
+            ..GaConfig::default()
+        };
+        let rep = tune(&sim, &trials, &b, &cfg).unwrap();
+        let conv = rep.conventional.clone().unwrap();
+        let g = rep.gain.clone().unwrap();
+        assert_eq!(g.records, trials.len());
+        assert_eq!(g.tuned_kept, g.mean > 0.0 && g.mean > 2.0 * g.se, "{g:?}");
+        if g.tuned_kept {
+            assert_eq!(rep.best_model, rep.tuned.model);
+        } else {
+            assert_eq!(rep.best_model, conv.model);
+            assert_eq!((rep.lambda, rep.best_fit), (0.0, conv.fitness));
+        }
+        // The conventional model as the GA's pick gains exactly nothing: it is kept as such,
+        // with λ = 0 and R = 0.
+        let same = GaReport {
+            best_model: conv.model.clone(),
+            gain: None,
+            lambda: 0.5,
+            r: vec![1.0; rep.r.len()],
+            ..rep.clone()
+        };
+        let s = settle(same, &trials, &cfg);
+        let g = s.gain.unwrap();
+        assert_eq!((g.mean, g.se, g.tuned_kept), (0.0, 0.0, false));
+        assert_eq!(s.best_model, conv.model);
+        assert_eq!(s.lambda, 0.0);
+        assert!(s.r.iter().all(|v| *v == 0.0));
     }
 }
