@@ -277,6 +277,13 @@ impl JsonArg {
     }
 }
 
+/// `value` as pretty JSON with a final newline (for [`yawcast::io::data::write_all_atomic`]).
+pub fn json_bytes<T: Serialize>(value: &T) -> Result<Vec<u8>> {
+    let mut bytes = serde_json::to_vec_pretty(value).context("serialising the JSON summary")?;
+    bytes.push(b'\n');
+    Ok(bytes)
+}
+
 /// Writes `value` as pretty JSON to `path`, atomically.
 pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<()> {
     let mut bytes = serde_json::to_vec_pretty(value).context("serialising the JSON summary")?;

@@ -9,8 +9,8 @@ use std::collections::BTreeMap;
 use yawcast::identify::predict::{self, Horizon};
 
 use super::common::{
-    check_fit, check_horizons_fit, check_record_for_model, parse_horizons, read_model, JsonArg,
-    ReadArgs,
+    check_fit, check_horizons_fit, check_record_for_model, json_bytes, parse_horizons, read_model,
+    JsonArg, ReadArgs,
 };
 
 /// The horizons compared when `--horizons` is not given (those not shorter than a record are
@@ -119,6 +119,8 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         mean_fit.insert(k, m);
     }
     print_table(&horizons, &out, &mean_fit);
+    // Every output is made in memory, then written together: all of them or none.
+    let mut files = Vec::new();
     if let Some(dir) = &args.out {
         for (rec, cols) in records.iter().zip(&series) {
             let mut s = String::from("t_s,delta_deg,r_degps");
@@ -133,18 +135,29 @@ pub fn run(args: &CompareArgs) -> Result<()> {
                 }
                 s.push('\n');
             }
-            let p = dir.join(format!("{}.compare.csv", rec.name));
-            yawcast::io::data::write_atomic(&p, s.as_bytes())?;
+            files.push((
+                dir.join(format!("{}.compare.csv", rec.name)),
+                s.into_bytes(),
+            ));
         }
+    }
+    if let Some(p) = &args.json.json {
+        files.push((
+            p.clone(),
+            json_bytes(&CompareSummary {
+                command: "compare",
+                model: args.model.display().to_string(),
+                horizons: horizons.iter().map(Horizon::key).collect(),
+                records: out,
+                mean_fit,
+            })?,
+        ));
+    }
+    yawcast::io::data::write_all_atomic(&files)?;
+    if let Some(dir) = &args.out {
         println!("series written to {}", dir.display());
     }
-    args.json.write(&CompareSummary {
-        command: "compare",
-        model: args.model.display().to_string(),
-        horizons: horizons.iter().map(Horizon::key).collect(),
-        records: out,
-        mean_fit,
-    })
+    Ok(())
 }
 
 fn print_table(horizons: &[Horizon], rows: &[RecordFit], mean: &BTreeMap<String, f64>) {

@@ -11,7 +11,7 @@ use yawcast::diagnose::resid::{resid, Correlation, ResidConfig, ResidReport};
 use yawcast::io::data::write_all_atomic;
 use yawcast::io::report::svg::stem_chart;
 
-use super::common::{bad, check_record_for_model, read_model, JsonArg, ReadArgs};
+use super::common::{bad, check_record_for_model, json_bytes, read_model, JsonArg, ReadArgs};
 
 /// Arguments of `yawcast resid`.
 #[derive(Debug, Args)]
@@ -90,9 +90,7 @@ pub fn run(args: &ResidArgs) -> Result<()> {
         ));
     }
     if let Some(p) = &args.json.json {
-        let mut bytes = serde_json::to_vec_pretty(&rep).context("serialising the summary")?;
-        bytes.push(b'\n');
-        files.push((p.clone(), bytes));
+        files.push((p.clone(), json_bytes(&rep)?));
     }
     write_all_atomic(&files).context("writing the outputs")?;
     if let Some(dir) = &args.out {

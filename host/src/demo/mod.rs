@@ -1236,11 +1236,26 @@ pub(crate) mod tests {
         assert!(firmware_check(m, &bad, &o.trials[0], None, 0).is_err());
     }
 
-    /// Writes the sample page for a look in a browser: `YAWCAST_REPORT_PREVIEW=path`.
+    /// Writes the sample page — to `YAWCAST_REPORT_PREVIEW=path` for a look in a browser,
+    /// else to a temporary file — and checks that the file holds the page as rendered.
     #[test]
     fn preview() {
-        if let Some(p) = std::env::var_os("YAWCAST_REPORT_PREVIEW") {
-            sample().report().write(std::path::Path::new(&p)).unwrap();
+        let path = std::env::var_os("YAWCAST_REPORT_PREVIEW")
+            .map(std::path::PathBuf::from)
+            .unwrap_or_else(|| {
+                std::env::temp_dir().join(format!("yawcast-preview-{}.html", std::process::id()))
+            });
+        let report = sample().report();
+        report.write(&path).unwrap();
+        let written = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(written, report.render());
+        assert!(written
+            .trim_start()
+            .to_ascii_lowercase()
+            .starts_with("<!doctype html>"));
+        assert!(written.matches("<svg").count() >= 5, "too few plots");
+        if std::env::var_os("YAWCAST_REPORT_PREVIEW").is_none() {
+            std::fs::remove_file(&path).unwrap();
         }
     }
 }
