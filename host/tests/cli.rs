@@ -1633,3 +1633,35 @@ fn settings_the_records_cannot_hold_are_refused_up_front() {
     // Refused on reading, before the starting model is identified.
     assert!(!stderr(&o).contains("generation"), "{}", stderr(&o));
 }
+
+/// A `.json` model passes the checks a `.postcard` blob gets: huge coefficients and an
+/// unstable predictor are refused with the file named (exit 2), before any record is read.
+#[test]
+fn json_models_pass_the_checks_a_blob_gets() {
+    let d = scratch("jsonmodel");
+    let f = d.join("r.csv");
+    std::fs::write(&f, csv_text(200, 0.5)).unwrap();
+    for (name, text) in [
+        (
+            "huge.json",
+            r#"{"n":2,"ts":0.5,"a":[1e308,0.7],"b":[0.01,0.02],"k":[0.5,0.2],"effects":[]}"#,
+        ),
+        (
+            "unstable.json",
+            r#"{"n":2,"ts":0.5,"a":[0.0,1.3],"b":[0.01,0.02],"k":[0.0,0.0],"effects":[]}"#,
+        ),
+    ] {
+        let m = d.join(name);
+        std::fs::write(&m, text).unwrap();
+        let o = run(&[
+            "compare",
+            "--model",
+            m.to_str().unwrap(),
+            "--data",
+            f.to_str().unwrap(),
+        ]);
+        assert_eq!(code(&o), 2, "{name}: {}", stderr(&o));
+        assert!(stderr(&o).contains(name), "{name}: {}", stderr(&o));
+        assert!(stdout(&o).is_empty(), "{name}: {}", stdout(&o));
+    }
+}

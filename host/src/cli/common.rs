@@ -430,6 +430,17 @@ fn model_from_json(bytes: &[u8], path: &Path) -> Result<Model> {
         .map_err(|e| bad(format!("{}: not a yawcast model: {e}", path.display())))?;
     m.validate()
         .map_err(|e| bad(format!("{}: {e}", path.display())))?;
+    // The same checks a blob gets on loading (magnitudes, stability of A and A − KC in the
+    // controller's f32 numbers): a model that could not be exported is not used either.
+    let spec = m
+        .to_spec()
+        .map_err(|e| bad(format!("{}: {e}", path.display())))?;
+    spec.validate().map_err(|e| {
+        bad(format!(
+            "{}: the model fails the checks a model blob gets: {e}",
+            path.display()
+        ))
+    })?;
     Ok(m)
 }
 
