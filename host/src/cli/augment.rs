@@ -233,6 +233,16 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
             twin.display()
         )));
     }
+    if args.null_reps == 0 {
+        return Err(bad(
+            "--null-reps 0: the null distributions need at least one replicate (default 40)",
+        ));
+    }
+    // The ship file is read before any work: a broken one must not surface after the model
+    // was written.
+    if let Some(p) = args.ship.as_ref().filter(|p| p.exists()) {
+        Ship::from_file(p).map_err(|e| bad(format!("{}: {e}", p.display())))?;
+    }
     let given = read_model(&args.model)?;
     let est = read_checked(&args.read, &args.data, &given)?;
     let val = read_checked(&args.read, &args.validate, &given)?;

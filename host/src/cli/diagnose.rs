@@ -92,6 +92,11 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
     let est = read_checked(args, &args.data, &model)?;
     let reference = read_checked(args, &args.reference, &model)?;
     let val = read_checked(args, &args.validate, &model)?;
+    if args.null_reps == 0 {
+        return Err(bad(
+            "--null-reps 0: the null distributions need at least one replicate (default 40)",
+        ));
+    }
     if !(args.alpha > 0.0 && args.alpha < 1.0) {
         return Err(bad(format!("--alpha {} is not in (0, 1)", args.alpha)));
     }

@@ -23,6 +23,15 @@ fn read_records(read: &ReadArgs, paths: &[PathBuf], option: &str) -> Result<Vec<
         .collect::<Result<Vec<_>>>()
 }
 
+/// The files of a repeatable option, for messages: `a.csv, b.csv`.
+fn names(paths: &[PathBuf]) -> String {
+    paths
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// Exports `model` as `<out>.postcard` + `<out>.json`, checked through the firmware on `check`.
 fn write_model(model: &Model, out: &Path, check: &Record) -> Result<export::ExportReport> {
     export::export(model, out, check)
@@ -172,7 +181,14 @@ pub struct IdentifySummary {
 /// Runs `identify`.
 pub fn identify(args: &IdentifyArgs) -> Result<()> {
     check_json_vs_out(args.out.as_deref(), &args.json)?;
+    if !(args.lambda.is_finite() && args.lambda >= 0.0) {
+        return Err(bad(format!(
+            "--lambda {}: expected a finite number ≥ 0",
+            args.lambda
+        )));
+    }
     let recs = read_records(&args.read, &args.data, "--data")?;
+    let from = || format!("identifying from {}", names(&args.data));
     let val = args.read.read_all(&args.validate)?;
     let cfg = pem::PemConfig {
         order: args.order,
@@ -205,7 +221,9 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
             ));
         }
         let orders = parse_orders(o)?;
-        let lines = pem::select_order(&recs, &orders, &cfg).map_err(input_ident)?;
+        let lines = pem::select_order(&recs, &orders, &cfg)
+            .map_err(input_ident)
+            .with_context(from)?;
         println!(
             "{:>5} {:>6} {:>12} {:>12} {:>12} {:>8} {:>8} {:>8} {:>8} {:>10}",
             "order",
@@ -249,13 +267,17 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
         }));
     }
     let started = std::time::Instant::now();
-    let (rep, offset) = pem::offset::identify(&recs, &cfg).map_err(input_ident)?;
+    let (rep, offset) = pem::offset::identify(&recs, &cfg)
+        .map_err(input_ident)
+        .with_context(from)?;
     let model = if horizons.iter().any(|k| *k > 1) {
         let fc = pem::focus::FocusConfig {
             horizons: horizons.clone(),
             ..Default::default()
         };
-        let f = pem::focus::refine(&recs, &rep.model, &fc).map_err(input_ident)?;
+        let f = pem::focus::refine(&recs, &rep.model, &fc)
+            .map_err(input_ident)
+            .with_context(from)?;
         let per: Vec<String> = f
             .horizons
             .iter()

@@ -131,6 +131,15 @@ fn numbered(out: &Path, i: usize, n: usize) -> PathBuf {
 
 /// Runs `yawcast simulate`.
 pub fn run(args: &SimulateArgs) -> Result<()> {
+    for (flag, v) in [
+        ("--gyro-noise", args.gyro_noise),
+        ("--heading-noise", args.heading_noise),
+        ("--speed-noise", args.speed_noise),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(bad(format!("{flag} {v}: expected a finite number ≥ 0")));
+        }
+    }
     let ship = match &args.ship {
         Some(p) => Ship::from_file(p).map_err(bad)?,
         None => Ship::default_lng(),
