@@ -100,6 +100,9 @@ mod app {
     }
 
     impl App {
+        // Called from two places (the built-in model at start-up, a LoadModel frame): inlined,
+        // blob decoding and model validation would be laid down twice (≈ 5 KiB of flash).
+        #[inline(never)]
         fn load(&mut self, bytes: &[u8]) -> DeviceMessage {
             let spec = match blob::decode_blob(bytes) {
                 Ok(spec) => spec,
