@@ -13,4 +13,5 @@ pub mod identify;
 pub mod io;
 mod par;
 pub mod sim;
+pub mod stats;
 pub mod tune;

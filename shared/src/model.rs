@@ -509,10 +509,10 @@ impl ModelSpec {
                 return Err(ModelError::EffectParameter(kind));
             }
         }
-        if !schur_stable(&shift_by_one(&companion_char_poly(&self.a, &[], n), n), n) {
+        if !monic_schur_stable(&shift_by_one(&companion_char_poly(&self.a, &[], n), n), n) {
             return Err(ModelError::UnstableModel);
         }
-        if !schur_stable(
+        if !monic_schur_stable(
             &shift_by_one(&companion_char_poly(&self.a, &self.k, n), n),
             n,
         ) {
@@ -642,9 +642,43 @@ fn shift_by_one(p: &Poly, n: usize) -> Poly {
     out
 }
 
-/// Schur–Cohn (Levinson step-down) test: `true` when every root of the monic polynomial
-/// `poly` of degree `n` lies strictly inside the unit circle.
-fn schur_stable(poly: &Poly, n: usize) -> bool {
+/// Schur–Cohn (Levinson step-down) test: `true` when every root of the polynomial
+/// `p[0] z^n + p[1] z^{n−1} + … + p[n]` (descending powers, `n = p.len() − 1 ≤ MAX_ORDER`)
+/// lies strictly inside the unit circle. `false` for a zero or non-finite leading coefficient,
+/// any non-finite coefficient, an empty slice or a degree above [`MAX_ORDER`].
+///
+/// This is the test [`ModelSpec::validate`] applies to `A` and `A − KC`; the host's
+/// identification uses the same function.
+///
+/// # Errors
+/// None: an argument it cannot judge is reported as not stable.
+///
+/// ```
+/// use yawcast_shared::model::schur_stable;
+/// // (z − 0.9)(z + 0.8) = z² − 0.1 z − 0.72: stable; a root at 1.05 is not.
+/// assert!(schur_stable(&[1.0, -0.1, -0.72]));
+/// assert!(schur_stable(&[2.0, -0.2, -1.44]));
+/// assert!(!schur_stable(&[1.0, -1.05]));
+/// assert!(!schur_stable(&[0.0, 1.0]));
+/// ```
+pub fn schur_stable(p: &[f64]) -> bool {
+    let n = match p.len().checked_sub(1) {
+        Some(n) if n <= MAX_ORDER => n,
+        _ => return false,
+    };
+    let lead = p[0];
+    if lead == 0.0 || !p.iter().all(|c| c.is_finite()) {
+        return false;
+    }
+    let mut c: Poly = [0.0; MAX_ORDER + 1];
+    for (d, v) in c.iter_mut().zip(p) {
+        *d = *v / lead;
+    }
+    monic_schur_stable(&c, n)
+}
+
+/// [`schur_stable`] for a monic polynomial of degree `n` held in a [`Poly`].
+fn monic_schur_stable(poly: &Poly, n: usize) -> bool {
     let n = n.min(MAX_ORDER);
     let mut c = *poly;
     for m in (1..=n).rev() {
@@ -674,7 +708,7 @@ mod tests {
     fn stable(c: &[f64]) -> bool {
         let mut p = [0.0; MAX_ORDER + 1];
         p[..c.len()].copy_from_slice(c);
-        schur_stable(&p, c.len() - 1)
+        monic_schur_stable(&p, c.len() - 1)
     }
 
     #[test]

@@ -82,11 +82,11 @@ use yawcast_shared::model::EffectKind;
 
 use crate::diagnose::augment::{AugmentConfig, AugmentReport};
 use crate::diagnose::compare::{check_inputs, mean_fit, InputError};
-use crate::diagnose::resid::{chi2_sf, normal_sf};
 use crate::identify::model::{Effect, Model};
 use crate::identify::pem::{self, PemConfig};
 use crate::identify::predict::{self, Horizon, Stepper};
 use crate::io::data::Record;
+use crate::stats::{chi2_sf, normal_sf, standard_normal as gauss};
 
 /// Horizon (samples) of the prediction errors the slow effects are fitted on.
 pub const SLOW_HORIZON: usize = 50;
@@ -547,13 +547,6 @@ fn effect_with(cand: &Effect, beta: &DVector<f64>) -> Effect {
 
 // ---------------------------------------------------------------------------------------
 // parametric bootstrap
-
-/// Standard normal by Box–Muller.
-fn gauss(rng: &mut ChaCha8Rng) -> f64 {
-    let u1: f64 = 1.0 - rng.random::<f64>();
-    let u2: f64 = rng.random::<f64>();
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-}
 
 /// Simulates the innovations model on the commands of `like` with innovation std `sigma`
 /// (heading integrated from the simulated rate, from the record's first heading).

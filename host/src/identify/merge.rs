@@ -13,6 +13,7 @@ use crate::identify::model::Model;
 use crate::identify::pem::{self, IdentError, PemConfig, PemReport};
 use crate::identify::predict::{self, Horizon};
 use crate::io::data::Record;
+use crate::stats::chi2_sf;
 
 /// Errors combining models.
 #[derive(Debug, Clone, Error, PartialEq)]
@@ -256,93 +257,6 @@ pub fn merge(reports: &[PemReport]) -> Result<Merged, MergeError> {
     })
 }
 
-/// ln Γ(x) for x > 0 (Lanczos, g = 7).
-fn ln_gamma(x: f64) -> f64 {
-    const C: [f64; 9] = [
-        0.999_999_999_999_809_9,
-        676.520_368_121_885_1,
-        -1_259.139_216_722_402_8,
-        771.323_428_777_653_1,
-        -176.615_029_162_140_6,
-        12.507_343_278_686_905,
-        -0.138_571_095_265_720_12,
-        9.984_369_578_019_572e-6,
-        1.505_632_735_149_311_6e-7,
-    ];
-    if x < 0.5 {
-        let pi = std::f64::consts::PI;
-        return (pi / (pi * x).sin()).ln() - ln_gamma(1.0 - x);
-    }
-    let x = x - 1.0;
-    let mut a = C[0];
-    let t = x + 7.5;
-    for (i, c) in C.iter().enumerate().skip(1) {
-        a += c / (x + i as f64);
-    }
-    0.5 * (2.0 * std::f64::consts::PI).ln() + (x + 0.5) * t.ln() - t + a.ln()
-}
-
-/// Regularised upper incomplete gamma Q(a, x).
-fn gamma_q(a: f64, x: f64) -> f64 {
-    if x <= 0.0 {
-        return 1.0;
-    }
-    let lg = ln_gamma(a);
-    if x < a + 1.0 {
-        // series for P
-        let mut sum = 1.0 / a;
-        let mut term = sum;
-        let mut ap = a;
-        for _ in 0..10_000 {
-            ap += 1.0;
-            term *= x / ap;
-            sum += term;
-            if term.abs() < sum.abs() * 1e-16 {
-                break;
-            }
-        }
-        let p = sum * (-x + a * x.ln() - lg).exp();
-        (1.0 - p).clamp(0.0, 1.0)
-    } else {
-        // continued fraction for Q (modified Lentz)
-        let tiny = 1e-300;
-        let mut b = x + 1.0 - a;
-        let mut c = 1.0 / tiny;
-        let mut d = 1.0 / b;
-        let mut h = d;
-        for i in 1..10_000 {
-            let an = -(i as f64) * (i as f64 - a);
-            b += 2.0;
-            d = an * d + b;
-            if d.abs() < tiny {
-                d = tiny;
-            }
-            c = b + an / c;
-            if c.abs() < tiny {
-                c = tiny;
-            }
-            d = 1.0 / d;
-            let del = d * c;
-            h *= del;
-            if (del - 1.0).abs() < 1e-16 {
-                break;
-            }
-        }
-        ((-x + a * x.ln() - lg).exp() * h).clamp(0.0, 1.0)
-    }
-}
-
-/// Survival function of the χ² distribution: `P(χ²_dof ≥ x)`.
-///
-/// ```
-/// use yawcast::identify::merge::chi2_sf;
-/// assert!((chi2_sf(3.841458820694124, 1.0) - 0.05).abs() < 1e-9);
-/// assert!((chi2_sf(4.0, 2.0) - (-2.0f64).exp()).abs() < 1e-12);
-/// ```
-pub fn chi2_sf(x: f64, dof: f64) -> f64 {
-    gamma_q(dof / 2.0, x / 2.0)
-}
-
 /// One way of combining, and how it validates.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Combination {
@@ -518,17 +432,6 @@ mod tests {
     use super::*;
     use crate::identify::model::Effect;
     use crate::identify::pem::testdata;
-
-    #[test]
-    fn chi2_survival_known_values() {
-        assert!((chi2_sf(2.0, 2.0) - (-1.0f64).exp()).abs() < 1e-12);
-        // P(χ²₁₀ ≥ 18.307) = 0.05
-        assert!((chi2_sf(18.307038053275146, 10.0) - 0.05).abs() < 1e-9);
-        // P(χ²₁₀₀ ≥ 124.342) = 0.05
-        assert!((chi2_sf(124.34211340400407, 100.0) - 0.05).abs() < 1e-8);
-        assert_eq!(chi2_sf(0.0, 3.0), 1.0);
-        assert!((ln_gamma(5.0) - 24f64.ln()).abs() < 1e-12);
-    }
 
     #[test]
     fn merge_of_two_scalar_like_estimates_is_inverse_variance_weighted() {

@@ -27,13 +27,14 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
-use yawcast_firmware::{Predictor, PredictorError, PredictorState};
+use yawcast_firmware::PredictorError;
 use yawcast_shared::blob::{self, FORMAT_VERSION, MAX_BLOB_LEN};
-use yawcast_shared::model::{ModelSpec, MAX_DEAD_TIME};
+use yawcast_shared::model::ModelSpec;
 
 use crate::identify::model::Model;
 use crate::identify::predict::{self, Horizon};
 use crate::io::data::{self, Record};
+use crate::io::hil::NativePredictor;
 
 /// Version of the JSON twin's layout.
 pub const JSON_FORMAT_VERSION: u32 = 1;
@@ -185,26 +186,15 @@ fn fw_err(e: PredictorError) -> ExportError {
     ExportError::Firmware(e.to_string())
 }
 
-fn run_n<const N: usize>(
+fn run_firmware(
     spec: &ModelSpec,
     x0: &[f64],
     psi0: f64,
     rec: &Record,
     h: usize,
 ) -> Result<FwRun, ExportError> {
-    let mut p = Predictor::<N>::new(spec).map_err(fw_err)?;
-    let mut x = [0.0f32; N];
-    for (xi, v) in x.iter_mut().zip(x0) {
-        *xi = *v as f32;
-    }
-    p.restore(PredictorState {
-        x,
-        delay: [0.0; MAX_DEAD_TIME as usize],
-        delay_head: 0,
-        u_prev: 0.0,
-        psi: psi0 as f32,
-    })
-    .map_err(fw_err)?;
+    let mut p = NativePredictor::new(spec).map_err(fw_err)?;
+    p.start_from(x0, psi0).map_err(fw_err)?;
     let u: Vec<f32> = rec.u.iter().map(|v| *v as f32).collect();
     let future = |t: Option<usize>| -> Vec<f32> {
         let last = u.last().copied().unwrap_or(0.0);
@@ -214,36 +204,16 @@ fn run_n<const N: usize>(
             .collect()
     };
     let mut initial = vec![0.0f32; h];
-    p.predict_into(&mut initial, &future(None))
-        .map_err(fw_err)?;
+    p.predict(&mut initial, &future(None)).map_err(fw_err)?;
     let mut after = Vec::with_capacity(rec.len());
     for t in 0..rec.len() {
         let psi = rec.psi.as_ref().map(|v| v[t] as f32);
-        p.update_with_heading(u[t], rec.y[t] as f32, psi);
+        p.update(u[t], rec.y[t] as f32, psi);
         let mut out = vec![0.0f32; h];
-        p.predict_into(&mut out, &future(Some(t))).map_err(fw_err)?;
+        p.predict(&mut out, &future(Some(t))).map_err(fw_err)?;
         after.push(out);
     }
     Ok(FwRun { initial, after })
-}
-
-fn run_firmware(
-    spec: &ModelSpec,
-    x0: &[f64],
-    psi0: f64,
-    rec: &Record,
-    h: usize,
-) -> Result<FwRun, ExportError> {
-    match spec.order {
-        2 => run_n::<2>(spec, x0, psi0, rec, h),
-        3 => run_n::<3>(spec, x0, psi0, rec, h),
-        4 => run_n::<4>(spec, x0, psi0, rec, h),
-        5 => run_n::<5>(spec, x0, psi0, rec, h),
-        6 => run_n::<6>(spec, x0, psi0, rec, h),
-        7 => run_n::<7>(spec, x0, psi0, rec, h),
-        8 => run_n::<8>(spec, x0, psi0, rec, h),
-        n => Err(ExportError::Model(format!("order {n} is outside 2..=8"))),
-    }
 }
 
 /// The firmware's k-step predictions ŷ(t|t−k) for every t (host semantics: the first k

@@ -27,7 +27,7 @@ use std::time::{Duration, Instant};
 use thiserror::Error;
 use yawcast_firmware::{Predictor, PredictorError};
 use yawcast_shared::blob::{encode_blob, MAX_BLOB_LEN};
-use yawcast_shared::model::ModelSpec;
+use yawcast_shared::model::{ModelError, ModelSpec, MAX_DEAD_TIME};
 use yawcast_shared::wire::{
     DeviceMessage, Feed, FrameAccumulator, FutureInputs, HostMessage, MAX_FRAME_LEN,
 };
@@ -110,11 +110,13 @@ macro_rules! each {
 }
 
 impl NativePredictor {
-    /// A predictor in the zero state for `spec`.
+    /// A predictor in the zero state for `spec`: the one dispatch from a model's order to the
+    /// firmware's const-generic `Predictor<N>` (export's check and `hil` both go through it).
     ///
     /// # Errors
-    /// [`HilError::Predictor`] when the firmware library refuses the model.
-    pub fn new(spec: &ModelSpec) -> Result<NativePredictor, HilError> {
+    /// [`PredictorError::InvalidModel`] with [`ModelError::Order`] for an order outside 2..=8, or the
+    /// firmware library's own refusal of the model.
+    pub fn new(spec: &ModelSpec) -> Result<NativePredictor, PredictorError> {
         Ok(match spec.order {
             2 => NativePredictor::N2(Predictor::new(spec)?),
             3 => NativePredictor::N3(Predictor::new(spec)?),
@@ -123,7 +125,27 @@ impl NativePredictor {
             6 => NativePredictor::N6(Predictor::new(spec)?),
             7 => NativePredictor::N7(Predictor::new(spec)?),
             8 => NativePredictor::N8(Predictor::new(spec)?),
-            n => return Err(HilError::Model(format!("order {n} is outside 2..=8"))),
+            n => return Err(ModelError::Order(n).into()),
+        })
+    }
+
+    /// Starts from the state `x0` (the model's difference coordinates, one value per state)
+    /// and integrated heading `psi0` (deg), with an empty delay line and the actuator at 0.
+    ///
+    /// # Errors
+    /// [`PredictorError::InvalidState`] when a value is not finite.
+    pub fn start_from(&mut self, x0: &[f64], psi0: f64) -> Result<(), PredictorError> {
+        each!(self, p => {
+            let mut st = p.state();
+            st.x.fill(0.0);
+            for (xi, v) in st.x.iter_mut().zip(x0) {
+                *xi = *v as f32;
+            }
+            st.delay = [0.0; MAX_DEAD_TIME as usize];
+            st.delay_head = 0;
+            st.u_prev = 0.0;
+            st.psi = psi0 as f32;
+            p.restore(st)
         })
     }
 
@@ -135,9 +157,9 @@ impl NativePredictor {
     /// ŷ(t+1|t) … ŷ(t+H|t) into `out` (H = `out.len()`), `future_u` = u(t+1) … u(t+H−1).
     ///
     /// # Errors
-    /// [`HilError::Predictor`] for a bad horizon, too few inputs or a non-finite prediction.
-    pub fn predict(&self, out: &mut [f32], future_u: &[f32]) -> Result<(), HilError> {
-        Ok(each!(self, p => p.predict_into(out, future_u))?)
+    /// [`PredictorError`] for a bad horizon, too few inputs or a non-finite prediction.
+    pub fn predict(&self, out: &mut [f32], future_u: &[f32]) -> Result<(), PredictorError> {
+        each!(self, p => p.predict_into(out, future_u))
     }
 }
 

@@ -76,12 +76,7 @@ pub(crate) fn rng(seed: u64, stream: u64) -> ChaCha8Rng {
     r
 }
 
-/// A standard normal draw (Box–Muller).
-pub(crate) fn gauss(r: &mut ChaCha8Rng) -> f64 {
-    let u1: f64 = 1.0 - r.random::<f64>();
-    let u2: f64 = r.random::<f64>();
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-}
+pub(crate) use crate::stats::standard_normal as gauss;
 
 impl InputSpec {
     /// Checks the parameters against the run length `n` and sample time `ts`.

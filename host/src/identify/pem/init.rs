@@ -363,10 +363,10 @@ mod tests {
     /// it).
     #[test]
     fn subspace_start_is_near_a_known_innovations_model() {
+        // One noise realisation moves the fast pole pair by up to ≈ 0.05 (seeds 1–12: 0.009
+        // to 0.051), so the start is judged over six records: each within 0.06, on average
+        // within 0.04.
         let truth = super::super::testdata::truth();
-        let rec = super::super::testdata::record(3, 2000);
-        let ut = rec.u.clone();
-        let (a, b, k) = subspace(std::slice::from_ref(&rec), &[ut], 4).unwrap();
         let poles = |a: &[f64]| {
             let mut p = vec![1.0];
             p.extend(a.iter().rev().map(|v| -v));
@@ -374,18 +374,38 @@ mod tests {
             r.sort_by(f64::total_cmp);
             r
         };
-        let (pe, pt) = (poles(&a), poles(&truth.a));
-        println!("pole moduli {pe:?} vs {pt:?}");
-        for (x, y) in pe.iter().zip(&pt) {
-            assert!((x - y).abs() < 0.05, "{pe:?} vs {pt:?}");
-        }
         let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
         let diff = |x: &[f64], y: &[f64]| {
             norm(&x.iter().zip(y).map(|(p, q)| p - q).collect::<Vec<_>>()) / norm(y)
         };
-        println!("b {b:?} vs {:?}; k {k:?} vs {:?}", truth.b, truth.k);
-        assert!(diff(&b, &truth.b) < 0.1, "b {b:?} vs {:?}", truth.b);
-        assert!(diff(&k, &truth.k) < 0.3, "k {k:?} vs {:?}", truth.k);
+        let pt = poles(&truth.a);
+        let mut worst = Vec::new();
+        for seed in 1..=6 {
+            let rec = super::super::testdata::record(seed, 2000);
+            let ut = rec.u.clone();
+            let (a, b, k) = subspace(std::slice::from_ref(&rec), &[ut], 4).unwrap();
+            let pe = poles(&a);
+            let w = pe
+                .iter()
+                .zip(&pt)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f64::max);
+            println!("seed {seed}: pole moduli {pe:?} vs {pt:?}; b {b:?}; k {k:?}");
+            assert!(w < 0.06, "seed {seed}: {pe:?} vs {pt:?}");
+            assert!(
+                diff(&b, &truth.b) < 0.1,
+                "seed {seed}: b {b:?} vs {:?}",
+                truth.b
+            );
+            assert!(
+                diff(&k, &truth.k) < 0.3,
+                "seed {seed}: k {k:?} vs {:?}",
+                truth.k
+            );
+            worst.push(w);
+        }
+        let mean = worst.iter().sum::<f64>() / worst.len() as f64;
+        assert!(mean < 0.04, "mean worst pole error {mean} ({worst:?})");
     }
 
     /// Too few samples for the block size: no start rather than a bad one.

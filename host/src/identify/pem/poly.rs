@@ -44,31 +44,10 @@ pub(crate) fn predictor_poly(a: &[f64], k: &[f64], out: &mut [f64; MAX_N + 1]) {
     }
 }
 
-/// Schur–Cohn (Levinson step-down) test: whether every root of the degree-`n` polynomial
-/// `p[..=n]` (leading coefficient non-zero) lies strictly inside the unit circle.
+/// Schur–Cohn test of the degree-`n` polynomial `p[..=n]`: the shared crate's, the very test
+/// the blob's validation applies.
 pub(crate) fn schur_stable(p: &[f64], n: usize) -> bool {
-    if p[0] == 0.0 || !p[..=n].iter().all(|c| c.is_finite()) {
-        return false;
-    }
-    let mut c = [0.0f64; MAX_N + 1];
-    for i in 0..=n {
-        c[i] = p[i] / p[0];
-    }
-    let mut m = n;
-    while m > 0 {
-        let r = c[m];
-        if r.abs() >= 1.0 {
-            return false;
-        }
-        let den = 1.0 - r * r;
-        let mut next = [0.0f64; MAX_N + 1];
-        for i in 0..m {
-            next[i] = (c[i] - r * c[m - i]) / den;
-        }
-        c = next;
-        m -= 1;
-    }
-    true
+    yawcast_shared::model::schur_stable(&p[..=n])
 }
 
 /// Largest root modulus the search accepts: a margin below 1 keeps the optimum away from the

@@ -31,12 +31,7 @@ pub(crate) fn truth() -> Model {
     Model::new(1.0, a, b, k).unwrap()
 }
 
-/// Standard normal by Box–Muller.
-pub(crate) fn normal(rng: &mut ChaCha8Rng) -> f64 {
-    let u1: f64 = rng.random::<f64>().max(1e-300);
-    let u2: f64 = rng.random::<f64>();
-    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
-}
+pub(crate) use crate::stats::standard_normal as normal;
 
 /// PRBS-like command: levels from `amps` (random sign), held for 3..=15 samples.
 pub(crate) fn prbs(rng: &mut ChaCha8Rng, len: usize, amps: &[f64]) -> Vec<f64> {
