@@ -13,7 +13,7 @@ Sub-commands (all run inside the pinned venv made by setup.sh):
     run.py fit       identify one model with one peer (run as a subprocess for timing)
     run.py selftest  checks of the shared predictor against closed forms and the libraries
 
-Scoring (DESIGN.md, "The model"):
+Scoring (docs/method.md, "The model and its predictions"):
   * one-step predictor x̂(t+1) = A x̂ + B v + K e, ŷ(t|t−1) = C x̂ + D ũ + offsets;
   * ŷ(t|t−k): take x̂(t−k+1|t−k) and run k−1 open-loop steps (no measurements); the first
     k samples are pure simulation from x̂(0); x̂(0) is the least-squares fit to the one-step
@@ -178,7 +178,7 @@ def standin_record(name, seed, n=2000, ts=0.5, noise=0.05, effect=None):
 
 class SSModel:
     """x(t+1) = A x + B v + K e;  ŷ = C x + D ũ + d_y + y0;  ũ = actuator(u − u0);
-    v = ũ + Σ β φ (yawcast effects; empty for peers).  Step semantics follow DESIGN.md
+    v = ũ + Σ β φ (yawcast effects; empty for peers).  Step semantics follow docs/method.md
     and host/src/identify/predict.rs: actuator (dead time → saturation → rate limit), heading,
     y_used, effect regressors, innovation, state update, heading integration."""
 
@@ -410,7 +410,7 @@ def _estimate_x0(m: SSModel, rec: Record):
 
 
 def predict_ss(m: SSModel, rec: Record, horizon, x0=None):
-    """ŷ at a horizon ("1", "5", …, "sim") with DESIGN.md's k-step semantics."""
+    """ŷ at a horizon ("1", "5", …, "sim") with the k-step semantics of docs/method.md."""
     if x0 is None:
         x0 = estimate_x0(m, rec)
     with np.errstate(all="ignore"):

@@ -2,7 +2,7 @@
 //! trial records *and* on the reference records the model was identified from; the verdict
 //! names what the trials have that the reference lacks, or `none`.
 //!
-//! The method (DESIGN.md, "what works"):
+//! The method (for users, in words: docs/method.md, "Diagnose and augment"):
 //!
 //! - **Frozen linear part.** θ stays at the model's values; each effect is added with its
 //!   structural parameter on a grid (dead time d, slew rate ρ, clip level, `y|y|` or `y³`)
