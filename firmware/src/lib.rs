@@ -273,13 +273,6 @@ impl<const N: usize> Predictor<N> {
                     beta_c1,
                 } => p.wind = Some([beta_s2, beta_c2, beta_s1, beta_c1]),
                 Effect::Current { beta_s, beta_c } => p.current = Some([beta_s, beta_c]),
-                // A kind this firmware does not know: refuse rather than ignore it.
-                #[allow(unreachable_patterns)]
-                _ => {
-                    return Err(PredictorError::InvalidModel(ModelError::EffectParameter(
-                        e.kind(),
-                    )))
-                }
             }
         }
         p.heading = p.wind.is_some() || p.current.is_some();

@@ -84,8 +84,10 @@ impl Default for Units {
 /// One effect of the library, with its parameters.
 ///
 /// The names used on the command line and in JSON are given by [`EffectKind::name`].
+///
+/// Not `#[non_exhaustive]`: every match over the library is exhaustive, so a new effect makes
+/// the compiler list each place that must learn it (the blob's format version guards the wire).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[non_exhaustive]
 pub enum Effect {
     /// Constant yaw moment (current, steady wind, propeller asymmetry): `φ = 1` through B.
     Bias {
@@ -146,8 +148,9 @@ pub enum Effect {
 }
 
 /// The kind of an effect, without parameters.
+///
+/// Not `#[non_exhaustive]`, like [`Effect`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
-#[non_exhaustive]
 pub enum EffectKind {
     /// See [`Effect::Bias`].
     Bias,

@@ -449,7 +449,7 @@ fn actuator_grid(kind: EffectKind, est: &[Record], ts: f64) -> Vec<f64> {
             let ratio = (hi / lo).powf(1.0 / (k - 1) as f64);
             (0..k).map(|i| lo * ratio.powi(i as i32)).collect()
         }
-        _ => {
+        EffectKind::Saturation => {
             let mut a: Vec<f64> = est
                 .iter()
                 .flat_map(|r| r.u.iter().map(|v| v.abs()))
@@ -471,6 +471,13 @@ fn actuator_grid(kind: EffectKind, est: &[Record], ts: f64) -> Vec<f64> {
             g.dedup_by(|a, b| (*a - *b).abs() <= 1e-6 * b.abs().max(1e-9));
             g
         }
+        // not actuator effects: nothing to grid
+        EffectKind::Bias
+        | EffectKind::GyroBias
+        | EffectKind::Asymmetry
+        | EffectKind::NonlinearDamping
+        | EffectKind::Wind
+        | EffectKind::Current => Vec::new(),
     }
 }
 
@@ -1567,7 +1574,13 @@ fn harmonics(e: &Effect) -> Option<[f64; 4]> {
             beta_c1,
         } => Some([beta_s2, beta_c2, beta_s1, beta_c1]),
         Effect::Current { beta_s, beta_c } => Some([0.0, 0.0, beta_s, beta_c]),
-        _ => None,
+        Effect::Bias { .. }
+        | Effect::GyroBias { .. }
+        | Effect::DeadTime { .. }
+        | Effect::RateLimit { .. }
+        | Effect::Saturation { .. }
+        | Effect::Asymmetry { .. }
+        | Effect::NonlinearDamping { .. } => None,
     }
 }
 

@@ -218,7 +218,11 @@ fn horizon_of(kind: EffectKind) -> usize {
         EffectKind::Bias | EffectKind::GyroBias | EffectKind::Wind | EffectKind::Current => {
             SLOW_HORIZON
         }
-        _ => 1,
+        EffectKind::DeadTime
+        | EffectKind::RateLimit
+        | EffectKind::Saturation
+        | EffectKind::Asymmetry
+        | EffectKind::NonlinearDamping => 1,
     }
 }
 
@@ -1233,7 +1237,6 @@ fn describe(kind: EffectKind) -> &'static str {
         EffectKind::NonlinearDamping => "extra nonlinear yaw damping",
         EffectKind::Wind => "a heading-dependent wind moment",
         EffectKind::Current => "a current",
-        _ => "an effect",
     }
 }
 
@@ -1484,7 +1487,13 @@ fn effect_evidence(
                 }
             }
         }
-        _ => {}
+        // the channels carry nothing of the actuator and hull effects, nor of a moment
+        EffectKind::Bias
+        | EffectKind::DeadTime
+        | EffectKind::RateLimit
+        | EffectKind::Saturation
+        | EffectKind::Asymmetry
+        | EffectKind::NonlinearDamping => {}
     }
     ev
 }

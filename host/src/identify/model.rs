@@ -118,7 +118,7 @@ impl Effect {
                 beta_s1: 0.0,
                 beta_c1: 0.0,
             },
-            _ => Effect::Current {
+            EffectKind::Current => Effect::Current {
                 beta_s: 0.0,
                 beta_c: 0.0,
             },
@@ -208,8 +208,8 @@ impl Effect {
         }
     }
 
-    fn from_spec(e: &sm::Effect) -> Option<Effect> {
-        Some(match *e {
+    fn from_spec(e: &sm::Effect) -> Effect {
+        match *e {
             sm::Effect::Bias { beta } => Effect::Bias { beta: beta.into() },
             sm::Effect::GyroBias { d_y } => Effect::GyroBias { d_y: d_y.into() },
             sm::Effect::DeadTime { samples } => Effect::DeadTime {
@@ -239,9 +239,7 @@ impl Effect {
                 beta_s: beta_s.into(),
                 beta_c: beta_c.into(),
             },
-            #[allow(unreachable_patterns)]
-            _ => return None,
-        })
+        }
     }
 }
 
@@ -398,7 +396,9 @@ impl Model {
                 Effect::GyroBias { .. } => &["d_y"],
                 Effect::Wind { .. } => &["beta_s2", "beta_c2", "beta_s1", "beta_c1"],
                 Effect::Current { .. } => &["beta_s", "beta_c"],
-                _ => &[],
+                Effect::DeadTime { .. } | Effect::RateLimit { .. } | Effect::Saturation { .. } => {
+                    &[]
+                }
             };
             for g in names {
                 v.push(format!("{}.{g}", e.kind().name()));
@@ -541,7 +541,7 @@ impl Model {
             a,
             b,
             k,
-            effects: spec.effects.iter().filter_map(Effect::from_spec).collect(),
+            effects: spec.effects.iter().map(Effect::from_spec).collect(),
         };
         m.validate()?;
         Ok(m)

@@ -395,7 +395,12 @@ impl Actuator {
                 SimEffect::Saturation { limit_deg } => {
                     act.limit = act.limit.min(limit_deg.to_radians());
                 }
-                _ => {}
+                SimEffect::Bias { .. }
+                | SimEffect::GyroBias { .. }
+                | SimEffect::Asymmetry { .. }
+                | SimEffect::NonlinearDamping { .. }
+                | SimEffect::Wind { .. }
+                | SimEffect::Current { .. } => {}
             }
         }
         act

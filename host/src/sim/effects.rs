@@ -185,8 +185,6 @@ impl SimEffect {
                 speed_mps: HIDDEN_CURRENT_MPS * s,
                 towards_deg: 90.0,
             },
-            // a kind added to the library later, without physics here yet: no effect
-            _ => SimEffect::Bias { yaw_moment_nm: 0.0 },
         }
     }
 
