@@ -23,6 +23,8 @@
 //! [`Predictor::update_with_heading`]`(u, y, psi)`:
 //! 1. actuator: `δ = u(t−d)` (pop the delay line, push `u`; `δ = u` when `d = 0`);
 //!    `τ = clamp(δ, −limit, limit)` with saturation, else `τ = δ`;
+//!    with a dead band of width `b`, `τ = clamp(ũ_prev, τ − b, τ + b)` (`τ − b` and `τ + b`
+//!    each rounded first);
 //!    `ũ = ũ_prev + clamp(τ − ũ_prev, −s, s)` with a rate limit, where `s = rate · ts` is
 //!    computed once when the model is loaded, else `ũ = τ`; then `ũ_prev = ũ`.
 //!    `clamp(x, lo, hi)` is `lo` if `x < lo`, `hi` if `x > hi`, else `x`.
@@ -181,6 +183,7 @@ pub struct Predictor<const N: usize = 4> {
     dy: Option<f32>,
     dead: u8,
     limit: Option<f32>,
+    band: Option<f32>,
     rate_step: Option<f32>,
     bias: Option<f32>,
     asym: Option<f32>,
@@ -245,6 +248,7 @@ impl<const N: usize> Predictor<N> {
             dy: None,
             dead: 0,
             limit: None,
+            band: None,
             rate_step: None,
             bias: None,
             asym: None,
@@ -273,6 +277,7 @@ impl<const N: usize> Predictor<N> {
                     beta_c1,
                 } => p.wind = Some([beta_s2, beta_c2, beta_s1, beta_c1]),
                 Effect::Current { beta_s, beta_c } => p.current = Some([beta_s, beta_c]),
+                Effect::DeadBand { width } => p.band = Some(width),
             }
         }
         p.heading = p.wind.is_some() || p.current.is_some();
@@ -456,7 +461,7 @@ impl<const N: usize> Predictor<N> {
         }
     }
 
-    /// The actuator chain: dead time, saturation, rate limit. Advances its state.
+    /// The actuator chain: dead time, saturation, dead band, rate limit. Advances its state.
     #[inline(always)]
     fn actuator(&self, st: &mut PredictorState<N>, u: f32) -> f32 {
         let delayed = if self.dead > 0 {
@@ -472,6 +477,10 @@ impl<const N: usize> Predictor<N> {
         let target = match self.limit {
             Some(l) => clamp(delayed, -l, l),
             None => delayed,
+        };
+        let target = match self.band {
+            Some(b) => clamp(st.u_prev, target - b, target + b),
+            None => target,
         };
         let ut = match self.rate_step {
             Some(s) => st.u_prev + clamp(target - st.u_prev, -s, s),
@@ -807,6 +816,7 @@ mod tests {
                 beta_s: -0.2,
                 beta_c: 0.1,
             },
+            Effect::DeadBand { width: 0.75 },
         ];
         for effects in [&[][..], &all[..]] {
             let mut p = Predictor::<4>::new(&model(effects)).unwrap();
@@ -853,6 +863,26 @@ mod tests {
             seen.push(p.state().u_prev);
         }
         assert_eq!(seen, [1.0, 2.0, 2.5, 2.5, 1.5, 0.5]);
+        // dead band 1.5: the pod stays until the command is more than 1.5 away, then
+        // follows 1.5 behind; with a 2 deg/s slew limit at ts 0.5 it moves at most 1 a step
+        let mut p = Predictor::<4>::new(&model(&[Effect::DeadBand { width: 1.5 }])).unwrap();
+        let mut seen = std::vec::Vec::new();
+        for u in [1.0, 2.0, 4.0, 3.0, 2.0, -1.0, 0.0] {
+            p.update(u, 0.0);
+            seen.push(p.state().u_prev);
+        }
+        assert_eq!(seen, [0.0, 0.5, 2.5, 2.5, 2.5, 0.5, 0.5]);
+        let m = model(&[
+            Effect::DeadBand { width: 1.5 },
+            Effect::RateLimit { rate: 2.0 },
+        ]);
+        let mut p = Predictor::<4>::new(&m).unwrap();
+        let mut seen = std::vec::Vec::new();
+        for u in [5.0, 5.0, 5.0, 5.0, 0.0] {
+            p.update(u, 0.0);
+            seen.push(p.state().u_prev);
+        }
+        assert_eq!(seen, [1.0, 2.0, 3.0, 3.5, 2.5]);
     }
 
     /// From the zero state one update gives x̂'_i = ((0 + 0) + b_i·v) + k_i·e, so v can be

@@ -28,7 +28,7 @@ pub const FORMAT_VERSION: u16 = 2;
 pub const HEADER_LEN: usize = 8;
 /// Bytes after the payload: the CRC.
 pub const TRAILER_LEN: usize = 4;
-/// Largest payload accepted. The largest valid model (order 8, all nine effects) needs 166.
+/// Largest payload accepted. The largest valid model (order 8, all ten effects) needs 171.
 pub const MAX_PAYLOAD_LEN: usize = 256;
 /// Largest blob: header, payload, CRC.
 pub const MAX_BLOB_LEN: usize = HEADER_LEN + MAX_PAYLOAD_LEN + TRAILER_LEN;
@@ -250,6 +250,7 @@ mod tests {
                     beta_s: 0.1,
                     beta_c: 0.1,
                 },
+                Effect::DeadBand { width: 1.0 },
             ],
         )
         .unwrap()
@@ -260,7 +261,7 @@ mod tests {
         let m = full_model();
         let mut buf = [0u8; MAX_BLOB_LEN];
         let blob = encode_blob(&m, &mut buf).unwrap();
-        assert_eq!(blob.len(), HEADER_LEN + 166 + TRAILER_LEN);
+        assert_eq!(blob.len(), HEADER_LEN + 171 + TRAILER_LEN);
         assert_eq!(decode_blob(blob), Ok(m));
     }
 

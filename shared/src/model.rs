@@ -16,8 +16,10 @@
 //! ```
 //!
 //! `u` is the commanded pod/rudder angle (deg), `y` the yaw rate (deg/s). `ũ` is `u` after the
-//! actuator model: dead time, then saturation of the delayed command, then the rate limit
-//! (the servo slews towards the saturated target), each optional. Every effect that
+//! actuator model: dead time, then saturation of the delayed command, then the dead band
+//! (backlash: the rudder/pod stays where it is until the target is more than the band's
+//! width away), then the rate limit (the servo slews towards what the band lets through),
+//! each optional. Every effect that
 //! "enters through B" adds `β φ(t)` to the effective input; `gyro-bias` is the output offset `d_y`.
 //!
 //! The host identifies the model in the shift form of the same parameterisation, `x(t+1) =
@@ -39,7 +41,7 @@ pub const MIN_ORDER: usize = 2;
 /// Largest model order accepted.
 pub const MAX_ORDER: usize = 8;
 /// Largest number of effects one model may carry (one of each kind).
-pub const MAX_EFFECTS: usize = 9;
+pub const MAX_EFFECTS: usize = 10;
 /// Largest dead time, in samples, the firmware keeps a delay line for.
 pub const MAX_DEAD_TIME: u8 = 32;
 
@@ -145,6 +147,16 @@ pub enum Effect {
         /// Gain of `cos ψ`.
         beta_c: f32,
     },
+    /// Steering-gear dead band (backlash, a worn gear): the rudder/pod does not move until
+    /// the (saturated) command differs from its position by more than `width`, then follows
+    /// it `width` behind: `ũ = clamp(ũ_prev, τ − width, τ + width)`.
+    ///
+    /// Last in the enum so that the blob's variant indices of the other effects are those
+    /// of format 2 blobs written before it existed.
+    DeadBand {
+        /// Width b in input units, `> 0`.
+        width: f32,
+    },
 }
 
 /// The kind of an effect, without parameters.
@@ -170,11 +182,13 @@ pub enum EffectKind {
     Wind,
     /// See [`Effect::Current`].
     Current,
+    /// See [`Effect::DeadBand`].
+    DeadBand,
 }
 
 impl EffectKind {
     /// Every kind, in library order.
-    pub const ALL: [EffectKind; 9] = [
+    pub const ALL: [EffectKind; 10] = [
         EffectKind::Bias,
         EffectKind::GyroBias,
         EffectKind::DeadTime,
@@ -184,6 +198,7 @@ impl EffectKind {
         EffectKind::NonlinearDamping,
         EffectKind::Wind,
         EffectKind::Current,
+        EffectKind::DeadBand,
     ];
 
     /// The stable name used on the command line and in JSON.
@@ -203,6 +218,7 @@ impl EffectKind {
             EffectKind::NonlinearDamping => "nonlinear-damping",
             EffectKind::Wind => "wind",
             EffectKind::Current => "current",
+            EffectKind::DeadBand => "dead-band",
         }
     }
 
@@ -225,10 +241,18 @@ impl EffectKind {
     /// assert!(!EffectKind::Wind.is_actuator());
     /// ```
     pub const fn is_actuator(self) -> bool {
-        matches!(
-            self,
-            EffectKind::DeadTime | EffectKind::RateLimit | EffectKind::Saturation
-        )
+        match self {
+            EffectKind::DeadTime
+            | EffectKind::RateLimit
+            | EffectKind::Saturation
+            | EffectKind::DeadBand => true,
+            EffectKind::Bias
+            | EffectKind::GyroBias
+            | EffectKind::Asymmetry
+            | EffectKind::NonlinearDamping
+            | EffectKind::Wind
+            | EffectKind::Current => false,
+        }
     }
 
     /// Whether the effect needs the heading ψ (measured or integrated from `r`).
@@ -238,7 +262,17 @@ impl EffectKind {
     /// assert!(EffectKind::Current.needs_heading());
     /// ```
     pub const fn needs_heading(self) -> bool {
-        matches!(self, EffectKind::Wind | EffectKind::Current)
+        match self {
+            EffectKind::Wind | EffectKind::Current => true,
+            EffectKind::Bias
+            | EffectKind::GyroBias
+            | EffectKind::DeadTime
+            | EffectKind::RateLimit
+            | EffectKind::Saturation
+            | EffectKind::Asymmetry
+            | EffectKind::NonlinearDamping
+            | EffectKind::DeadBand => false,
+        }
     }
 }
 
@@ -260,6 +294,7 @@ impl Effect {
             Effect::NonlinearDamping { .. } => EffectKind::NonlinearDamping,
             Effect::Wind { .. } => EffectKind::Wind,
             Effect::Current { .. } => EffectKind::Current,
+            Effect::DeadBand { .. } => EffectKind::DeadBand,
         }
     }
 }
@@ -561,6 +596,7 @@ fn effect_ok(e: &Effect) -> bool {
             beta_c1,
         } => sane(beta_s2) && sane(beta_c2) && sane(beta_s1) && sane(beta_c1),
         Effect::Current { beta_s, beta_c } => sane(beta_s) && sane(beta_c),
+        Effect::DeadBand { width } => sane(width) && width > 0.0,
     }
 }
 

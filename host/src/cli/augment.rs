@@ -23,7 +23,7 @@ pub struct AugmentArgs {
     #[arg(long, value_name = "FILE")]
     pub model: PathBuf,
     /// The effect to add (bias, gyro-bias, dead-time, rate-limit, saturation, asymmetry,
-    /// nonlinear-damping, wind, current), `auto` for the verdict of `yawcast diagnose`, or
+    /// nonlinear-damping, wind, current, dead-band), `auto` for the verdict of `yawcast diagnose`, or
     /// `none` (with `--more`: only the search).
     #[arg(long, value_name = "NAME")]
     pub effect: String,
@@ -296,7 +296,7 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
                 "ship file {} ({}) now carries {}",
                 path.display(),
                 ship.name,
-                describe_sim(&se)
+                se.describe()
             );
             ship_written = Some(path.clone());
             sim_effect = Some(se);
@@ -577,31 +577,6 @@ fn write_ship(
     yawcast::io::data::write_atomic(path, text.as_bytes())
         .with_context(|| format!("writing the ship file {}", path.display()))?;
     Ok((ship, se))
-}
-
-fn describe_sim(e: &SimEffect) -> String {
-    match *e {
-        SimEffect::Bias { yaw_moment_nm } => format!("a yaw moment of {yaw_moment_nm:.1} N·m"),
-        SimEffect::GyroBias { bias_degps } => format!("a gyro bias of {bias_degps:.3} °/s"),
-        SimEffect::DeadTime { delay_s } => format!("a dead time of {delay_s:.1} s"),
-        SimEffect::RateLimit { rate_degps } => format!("a slew limit of {rate_degps:.2} °/s"),
-        SimEffect::Saturation { limit_deg } => format!("an angle limit of {limit_deg:.1}°"),
-        SimEffect::Asymmetry { starboard_gain } => {
-            format!("a starboard gain of {:+.0} %", 100.0 * starboard_gain)
-        }
-        SimEffect::NonlinearDamping { n_rr, cubic } => format!(
-            "extra Norrbin damping n_rr = {n_rr:.3}{}",
-            if cubic { " (cubic)" } else { "" }
-        ),
-        SimEffect::Wind {
-            speed_mps,
-            from_deg,
-        } => format!("a wind of {speed_mps:.2} m/s from {from_deg:03.0}°"),
-        SimEffect::Current {
-            speed_mps,
-            towards_deg,
-        } => format!("a current of {speed_mps:.3} m/s towards {towards_deg:03.0}°"),
-    }
 }
 
 fn print_report(rep: &AugmentReport, secs: f64) {

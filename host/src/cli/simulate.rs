@@ -19,7 +19,7 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "SHIP.toml")]
     pub ship: Option<PathBuf>,
     /// Switch on a library effect at its canonical strength (repeatable): bias, gyro-bias,
-    /// dead-time, rate-limit, saturation, asymmetry, nonlinear-damping, wind, current.
+    /// dead-time, rate-limit, saturation, asymmetry, nonlinear-damping, wind, current, dead-band.
     #[arg(long, value_name = "NAME")]
     pub effect: Vec<String>,
     /// Strength of the `--effect`s (1 full, 0.5 half).

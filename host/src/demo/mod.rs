@@ -1014,20 +1014,11 @@ pub fn firmware_check(
     })
 }
 
-/// The effect in words ("a command dead time", …).
+/// The effect named `name` in words ("a command dead time", …; diagnose's phrase), "no
+/// effect" for `none` and anything that is not an effect name.
 pub fn effect_phrase(name: &str) -> &'static str {
-    match name {
-        "bias" => "a constant yaw moment",
-        "gyro-bias" => "a rate-gyro offset",
-        "dead-time" => "a command dead time",
-        "rate-limit" => "a pod slew-rate limit",
-        "saturation" => "a pod angle limit",
-        "asymmetry" => "a port/starboard asymmetry",
-        "nonlinear-damping" => "nonlinear hull damping",
-        "wind" => "a heading-dependent wind moment",
-        "current" => "a current drift moment",
-        _ => "an unknown effect",
-    }
+    yawcast_shared::model::EffectKind::from_name(name)
+        .map_or("no effect", crate::diagnose::effect_phrase)
 }
 
 #[cfg(test)]

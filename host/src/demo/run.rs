@@ -122,36 +122,6 @@ pub fn hidden_kind(seed: u64) -> EffectKind {
     EffectKind::ALL[rng.random_range(0..EffectKind::ALL.len())]
 }
 
-/// The hidden effect's physical parameters in words.
-fn describe_sim(e: &SimEffect) -> String {
-    match *e {
-        SimEffect::Bias { yaw_moment_nm } => {
-            format!("a constant yaw moment of {yaw_moment_nm:.0} N·m")
-        }
-        SimEffect::GyroBias { bias_degps } => format!("a rate-gyro offset of {bias_degps:.2} °/s"),
-        SimEffect::DeadTime { delay_s } => format!("a command dead time of {delay_s:.1} s"),
-        SimEffect::RateLimit { rate_degps } => format!("a pod slew limit of {rate_degps:.1} °/s"),
-        SimEffect::Saturation { limit_deg } => format!("a pod angle limit of ±{limit_deg:.1}°"),
-        SimEffect::Asymmetry { starboard_gain } => format!(
-            "pods {:.0} % more effective to starboard",
-            100.0 * starboard_gain
-        ),
-        SimEffect::NonlinearDamping { n_rr, .. } => {
-            format!("extra Norrbin yaw damping n_rr = {n_rr:.2}")
-        }
-        SimEffect::Wind {
-            speed_mps,
-            from_deg,
-        } => {
-            format!("a steady wind of {speed_mps:.1} m/s from {from_deg:.0}°")
-        }
-        SimEffect::Current {
-            speed_mps,
-            towards_deg,
-        } => format!("a current of {speed_mps:.2} m/s setting towards {towards_deg:.0}°"),
-    }
-}
-
 fn fits_of(model: &Model, recs: &[Record]) -> Fits {
     merge::validation_fits(model, recs)
 }
@@ -511,7 +481,7 @@ pub fn run(cfg: &DemoConfig, say: &mut dyn FnMut(&str)) -> Result<Outcome, DemoE
         seed,
         ship: cfg.ship.name.clone(),
         hidden_effect: hidden_kind.name().to_string(),
-        hidden_detail: describe_sim(&hidden),
+        hidden_detail: hidden.describe(),
         ident,
         trials: trials.clone(),
         conventional,
@@ -603,7 +573,7 @@ fn ship_loop(
     let text = ship.to_toml_string().map_err(step("ship file"))?;
     let note = format!(
         "{} written into ship.toml; a model identified on {} re-simulated records now scores {} → {} % at 10 steps on the held-out trials",
-        describe_sim(&sim_effect),
+        sim_effect.describe(),
         n_loop,
         fmt1(before.get("10")),
         fmt1(after.get("10"))

@@ -76,14 +76,20 @@ pub enum InputError {
         sample: usize,
     },
     /// An effect name that is not in the library.
-    #[error(
-        "unknown effect `{0}`; the library has bias, gyro-bias, dead-time, rate-limit, \
-         saturation, asymmetry, nonlinear-damping, wind, current"
-    )]
+    #[error("unknown effect `{0}`; the library has {names}", names = library_names())]
     UnknownEffect(String),
     /// A configuration value is out of range.
     #[error("bad setting: {0}")]
     Config(String),
+}
+
+/// The library's effect names, comma-separated, in library order.
+fn library_names() -> String {
+    yawcast_shared::model::EffectKind::ALL
+        .iter()
+        .map(|k| k.name())
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// Checks `model` and that every record in `recs` matches it: same sample time (relative

@@ -221,6 +221,7 @@ fn horizon_of(kind: EffectKind) -> usize {
         EffectKind::DeadTime
         | EffectKind::RateLimit
         | EffectKind::Saturation
+        | EffectKind::DeadBand
         | EffectKind::Asymmetry
         | EffectKind::NonlinearDamping => 1,
     }
@@ -396,6 +397,10 @@ fn grid(kind: EffectKind, ts: f64, u_max: f64, du_max: f64) -> Vec<Effect> {
             .into_iter()
             .map(|limit| Effect::Saturation { limit })
             .collect(),
+        EffectKind::DeadBand => band_widths(u_max)
+            .into_iter()
+            .map(|width| Effect::DeadBand { width })
+            .collect(),
         EffectKind::NonlinearDamping => vec![
             Effect::NonlinearDamping {
                 beta: 0.0,
@@ -406,8 +411,26 @@ fn grid(kind: EffectKind, ts: f64, u_max: f64, du_max: f64) -> Vec<Effect> {
                 cubic: true,
             },
         ],
-        k => vec![Effect::zero(k, 0.0)],
+        // one structure each, the gains to be fitted
+        EffectKind::Bias
+        | EffectKind::GyroBias
+        | EffectKind::Asymmetry
+        | EffectKind::Wind
+        | EffectKind::Current => vec![Effect::zero(kind, 0.0)],
     }
+}
+
+/// The dead-band widths searched, by diagnose and by augment alike: 12 geometric steps from
+/// 2 % to 40 % of the largest command (0.4° to 8° for the usual ±20° trials; worn gears show
+/// 0.5–3°).
+///
+/// ```
+/// let w = yawcast::diagnose::band_widths(20.0);
+/// assert_eq!(w.len(), 12);
+/// assert!((w[0] - 0.4).abs() < 1e-12 && (w[11] - 8.0).abs() < 1e-9);
+/// ```
+pub fn band_widths(u_max: f64) -> Vec<f64> {
+    geometric(0.02 * u_max, 0.4 * u_max, 12)
 }
 
 fn geometric(lo: f64, hi: f64, n: usize) -> Vec<f64> {
@@ -1041,7 +1064,7 @@ pub fn diagnose(
             let r = &ranking[i];
             let mut s = format!(
                 "The trials show {} that the {} lacks: {} (p {}, held-out fit gain {:+.1} pp).",
-                describe(e.kind),
+                effect_phrase(e.kind),
                 if has_ref { "reference" } else { "model" },
                 e.words,
                 fmt_p(r.p_value),
@@ -1226,7 +1249,14 @@ fn fmt_p(p: f64) -> String {
     }
 }
 
-fn describe(kind: EffectKind) -> &'static str {
+/// The effect in a few words ("a command dead time"), as the verdict, the demo and its report
+/// name it.
+///
+/// ```
+/// use yawcast_shared::model::EffectKind;
+/// assert_eq!(yawcast::diagnose::effect_phrase(EffectKind::DeadBand), "a steering-gear dead band");
+/// ```
+pub fn effect_phrase(kind: EffectKind) -> &'static str {
     match kind {
         EffectKind::Bias => "a constant yaw moment",
         EffectKind::GyroBias => "a rate-gyro offset",
@@ -1237,6 +1267,7 @@ fn describe(kind: EffectKind) -> &'static str {
         EffectKind::NonlinearDamping => "extra nonlinear yaw damping",
         EffectKind::Wind => "a heading-dependent wind moment",
         EffectKind::Current => "a current",
+        EffectKind::DeadBand => "a steering-gear dead band",
     }
 }
 
@@ -1393,6 +1424,13 @@ fn effect_evidence(
                  {limit:.1}° explains {pct:.0} % of the one-step error energy"
             );
         }
+        Effect::DeadBand { width } => {
+            ev.parameter = Some(width);
+            ev.words = format!(
+                "small steering corrections do not reach the ship and reversals arrive short; a \
+                 dead band of {width:.2}° explains {pct:.0} % of the one-step error energy"
+            );
+        }
         Effect::Asymmetry { beta } => {
             ev.parameter = Some(beta);
             ev.words = format!(
@@ -1492,6 +1530,7 @@ fn effect_evidence(
         | EffectKind::DeadTime
         | EffectKind::RateLimit
         | EffectKind::Saturation
+        | EffectKind::DeadBand
         | EffectKind::Asymmetry
         | EffectKind::NonlinearDamping => {}
     }

@@ -66,6 +66,11 @@ pub enum Effect {
         /// Gain of cos ψ.
         beta_c: f64,
     },
+    /// Steering-gear dead band b (deg): `ũ = clamp(ũ_prev, τ − b, τ + b)`.
+    DeadBand {
+        /// b (deg).
+        width: f64,
+    },
 }
 
 impl Effect {
@@ -86,6 +91,7 @@ impl Effect {
             Effect::NonlinearDamping { .. } => EffectKind::NonlinearDamping,
             Effect::Wind { .. } => EffectKind::Wind,
             Effect::Current { .. } => EffectKind::Current,
+            Effect::DeadBand { .. } => EffectKind::DeadBand,
         }
     }
 
@@ -107,6 +113,7 @@ impl Effect {
             },
             EffectKind::RateLimit => Effect::RateLimit { rate: structural },
             EffectKind::Saturation => Effect::Saturation { limit: structural },
+            EffectKind::DeadBand => Effect::DeadBand { width: structural },
             EffectKind::Asymmetry => Effect::Asymmetry { beta: 0.0 },
             EffectKind::NonlinearDamping => Effect::NonlinearDamping {
                 beta: 0.0,
@@ -143,9 +150,10 @@ impl Effect {
                 beta_c1,
             } => vec![beta_s2, beta_c2, beta_s1, beta_c1],
             Effect::Current { beta_s, beta_c } => vec![beta_s, beta_c],
-            Effect::DeadTime { .. } | Effect::RateLimit { .. } | Effect::Saturation { .. } => {
-                vec![]
-            }
+            Effect::DeadTime { .. }
+            | Effect::RateLimit { .. }
+            | Effect::Saturation { .. }
+            | Effect::DeadBand { .. } => vec![],
         }
     }
 
@@ -170,7 +178,10 @@ impl Effect {
                 *beta_s = g[0];
                 *beta_c = g[1];
             }
-            Effect::DeadTime { .. } | Effect::RateLimit { .. } | Effect::Saturation { .. } => {}
+            Effect::DeadTime { .. }
+            | Effect::RateLimit { .. }
+            | Effect::Saturation { .. }
+            | Effect::DeadBand { .. } => {}
         }
     }
 
@@ -182,6 +193,9 @@ impl Effect {
                 samples: samples.min(255) as u8,
             },
             Effect::RateLimit { rate } => sm::Effect::RateLimit { rate: rate as f32 },
+            Effect::DeadBand { width } => sm::Effect::DeadBand {
+                width: width as f32,
+            },
             Effect::Saturation { limit } => sm::Effect::Saturation {
                 limit: limit as f32,
             },
@@ -216,6 +230,9 @@ impl Effect {
                 samples: samples.into(),
             },
             sm::Effect::RateLimit { rate } => Effect::RateLimit { rate: rate.into() },
+            sm::Effect::DeadBand { width } => Effect::DeadBand {
+                width: width.into(),
+            },
             sm::Effect::Saturation { limit } => Effect::Saturation {
                 limit: limit.into(),
             },
@@ -396,9 +413,10 @@ impl Model {
                 Effect::GyroBias { .. } => &["d_y"],
                 Effect::Wind { .. } => &["beta_s2", "beta_c2", "beta_s1", "beta_c1"],
                 Effect::Current { .. } => &["beta_s", "beta_c"],
-                Effect::DeadTime { .. } | Effect::RateLimit { .. } | Effect::Saturation { .. } => {
-                    &[]
-                }
+                Effect::DeadTime { .. }
+                | Effect::RateLimit { .. }
+                | Effect::Saturation { .. }
+                | Effect::DeadBand { .. } => &[],
             };
             for g in names {
                 v.push(format!("{}.{g}", e.kind().name()));

@@ -2,7 +2,8 @@
 //!
 //! The step semantics are exactly those of the firmware's `Predictor` (in f64 rather than f32):
 //!
-//! 1. actuator: `delayed = u(t−d)`; `target = clamp(delayed, ±limit)`;
+//! 1. actuator: `delayed = u(t−d)`; `target = clamp(delayed, ±limit)`; with a dead band b,
+//!    `target = clamp(ũ_prev, target − b, target + b)`;
 //!    `ũ = ũ_prev + clamp(target − ũ_prev, ±ρ·Ts)` (or `target` without a rate limit);
 //! 2. heading `ψ` = measured ψ when given, else the integrated `ψ̂`;
 //! 3. `y_used` = measured y when finite, else `ŷ = x̂₁ + d_y`;
@@ -95,6 +96,7 @@ pub struct Stepper {
     d: usize,
     rate: Option<f64>,
     limit: Option<f64>,
+    band: Option<f64>,
     d_y: f64,
     bias: f64,
     asym: f64,
@@ -135,6 +137,7 @@ impl Stepper {
                 Effect::DeadTime { samples } => s.d = samples,
                 Effect::RateLimit { rate } => s.rate = Some(rate),
                 Effect::Saturation { limit } => s.limit = Some(limit),
+                Effect::DeadBand { width } => s.band = Some(width),
                 Effect::Asymmetry { beta } => s.asym = beta,
                 Effect::NonlinearDamping { beta, cubic } => {
                     s.damp = beta;
@@ -195,6 +198,20 @@ impl Stepper {
         let target = match self.limit {
             Some(l) => delayed.clamp(-l, l),
             None => delayed,
+        };
+        let target = match self.band {
+            // the firmware's comparisons, lower bound first (f64::clamp panics on a NaN bound)
+            Some(b) => {
+                let (lo, hi) = (target - b, target + b);
+                if st.u_prev < lo {
+                    lo
+                } else if st.u_prev > hi {
+                    hi
+                } else {
+                    st.u_prev
+                }
+            }
+            None => target,
         };
         let ut = match self.rate {
             Some(r) => {
@@ -544,6 +561,17 @@ mod tests {
             .map(|u| s.actuator(&mut st, *u))
             .collect();
         assert_eq!(outs, vec![0.0, 0.0, 2.0, 4.0, 5.0, 5.0]);
+        // dead band 1.5 before the 2 deg/s slew limit, as in the firmware
+        let m = m4()
+            .with_effect(Effect::DeadBand { width: 1.5 })
+            .with_effect(Effect::RateLimit { rate: 2.0 });
+        let s = Stepper::new(&m);
+        let mut st = s.initial(&[0.0; 4], 0.0);
+        let outs: Vec<f64> = [1.0, 5.0, 5.0, 5.0, 0.0, 1.0]
+            .iter()
+            .map(|u| s.actuator(&mut st, *u))
+            .collect();
+        assert_eq!(outs, vec![0.0, 2.0, 3.5, 3.5, 1.5, 1.5]);
     }
 
     #[test]

@@ -152,7 +152,13 @@ impl Model {
                     let a = towards_deg.to_radians();
                     model.current_ne = (speed_mps * a.cos(), speed_mps * a.sin());
                 }
-                _ => {}
+                // the gyro offset is added to the measurement, the actuator effects act in
+                // [`Actuator`]
+                SimEffect::GyroBias { .. }
+                | SimEffect::DeadTime { .. }
+                | SimEffect::RateLimit { .. }
+                | SimEffect::Saturation { .. }
+                | SimEffect::DeadBand { .. } => {}
             }
         }
         model
@@ -371,6 +377,8 @@ pub(crate) struct Actuator {
     pub slew: f64,
     /// Servo time constant (s).
     pub tau: f64,
+    /// Dead band (backlash) width (rad), 0 without one.
+    pub band: f64,
     /// Actual pod angle (rad).
     pub delta: f64,
 }
@@ -384,6 +392,7 @@ impl Actuator {
             limit: a.max_angle_deg.to_radians(),
             slew: a.slew_degps.to_radians(),
             tau: a.servo_tau_s,
+            band: 0.0,
             delta: 0.0,
         };
         for e in effects {
@@ -395,6 +404,7 @@ impl Actuator {
                 SimEffect::Saturation { limit_deg } => {
                     act.limit = act.limit.min(limit_deg.to_radians());
                 }
+                SimEffect::DeadBand { width_deg } => act.band += width_deg.to_radians(),
                 SimEffect::Bias { .. }
                 | SimEffect::GyroBias { .. }
                 | SimEffect::Asymmetry { .. }
@@ -407,10 +417,17 @@ impl Actuator {
     }
 
     /// Moves the pod angle over `dt` towards the (delayed) command `cmd` (rad): the limit
-    /// clips the target, the servo lag is integrated exactly, the slew limit clips the move.
+    /// clips the target, a dead band leaves the pods where they are while the target is
+    /// within the band and otherwise aims them the band's width short of it, the servo lag
+    /// is integrated exactly, the slew limit clips the move.
     #[inline]
     pub(crate) fn step(&mut self, cmd: f64, dt: f64) {
         let target = cmd.clamp(-self.limit, self.limit);
+        let target = if self.band > 0.0 {
+            self.delta.clamp(target - self.band, target + self.band)
+        } else {
+            target
+        };
         let lag = if self.tau > 0.0 {
             1.0 - (-dt / self.tau).exp()
         } else {

@@ -76,6 +76,13 @@ pub enum SimEffect {
         /// Direction the current sets *towards* (deg).
         towards_deg: f64,
     },
+    /// Steering-gear dead band (backlash of a worn gear): the pods do not move until the
+    /// command differs from their angle by more than the width, then follow it that far
+    /// behind.
+    DeadBand {
+        /// Width (deg), `> 0`.
+        width_deg: f64,
+    },
 }
 
 /// Yaw moment of the default ship's pods at about 4.5° at its approach speed (N·m): the
@@ -98,6 +105,8 @@ pub const HIDDEN_N_RR: f64 = 0.15;
 pub const HIDDEN_WIND_MPS: f64 = 3.0;
 /// Hidden `current` at full strength (m/s at model scale).
 pub const HIDDEN_CURRENT_MPS: f64 = 0.3;
+/// Hidden `dead-band` at full strength (deg): the backlash of a worn steering gear.
+pub const HIDDEN_DEAD_BAND_DEG: f64 = 2.0;
 
 impl SimEffect {
     /// The library kind of this effect.
@@ -119,6 +128,7 @@ impl SimEffect {
             SimEffect::NonlinearDamping { .. } => EffectKind::NonlinearDamping,
             SimEffect::Wind { .. } => EffectKind::Wind,
             SimEffect::Current { .. } => EffectKind::Current,
+            SimEffect::DeadBand { .. } => EffectKind::DeadBand,
         }
     }
 
@@ -129,12 +139,12 @@ impl SimEffect {
     /// plausible: bias 60 N·m (≈ the pods' moment at 4.5°), gyro bias 0.25 °/s, dead time
     /// 2 s, slew limit 3 °/s, angle limit 8°, asymmetry +40 % to starboard, extra Norrbin
     /// damping `n_rr` = 0.15, wind 3 m/s from 045° (Beaufort 7 Froude-scaled), current
-    /// 0.3 m/s setting towards 090°. Additive effects scale linearly with `strength`; the
+    /// 0.3 m/s setting towards 090°, a steering-gear dead band of 2°. Additive effects and
+    /// the dead band scale linearly with `strength`; the
     /// slew limit is divided by it; the angle limit moves from 20° (the largest
     /// identification amplitude) towards 8°. A `strength` at or below zero is taken as
     /// 1e-6 (practically no effect); a non-finite one gives parameters that
-    /// [`simulate`](super::simulate) rejects. A library kind the simulator has no physics
-    /// for gives a zero bias (no effect).
+    /// [`simulate`](super::simulate) rejects.
     ///
     /// ```
     /// use yawcast::sim::SimEffect;
@@ -185,6 +195,54 @@ impl SimEffect {
                 speed_mps: HIDDEN_CURRENT_MPS * s,
                 towards_deg: 90.0,
             },
+            EffectKind::DeadBand => SimEffect::DeadBand {
+                width_deg: HIDDEN_DEAD_BAND_DEG * s,
+            },
+        }
+    }
+
+    /// The effect's physical parameters in words, as the demo and `augment --save-ship` print
+    /// them.
+    ///
+    /// ```
+    /// use yawcast::sim::SimEffect;
+    /// assert_eq!(SimEffect::RateLimit { rate_degps: 3.0 }.describe(), "a pod slew limit of 3.00 °/s");
+    /// assert_eq!(SimEffect::DeadBand { width_deg: 2.0 }.describe(), "a steering-gear dead band of 2.00°");
+    /// ```
+    pub fn describe(&self) -> String {
+        match *self {
+            SimEffect::Bias { yaw_moment_nm } => {
+                format!("a constant yaw moment of {yaw_moment_nm:.1} N·m")
+            }
+            SimEffect::GyroBias { bias_degps } => {
+                format!("a rate-gyro offset of {bias_degps:.3} °/s")
+            }
+            SimEffect::DeadTime { delay_s } => format!("a command dead time of {delay_s:.1} s"),
+            SimEffect::RateLimit { rate_degps } => {
+                format!("a pod slew limit of {rate_degps:.2} °/s")
+            }
+            SimEffect::Saturation { limit_deg } => {
+                format!("a pod angle limit of ±{limit_deg:.1}°")
+            }
+            SimEffect::Asymmetry { starboard_gain } => format!(
+                "pods {:+.0} % more effective to starboard",
+                100.0 * starboard_gain
+            ),
+            SimEffect::NonlinearDamping { n_rr, cubic } => format!(
+                "extra Norrbin yaw damping n_rr = {n_rr:.3}{}",
+                if cubic { " (cubic)" } else { "" }
+            ),
+            SimEffect::Wind {
+                speed_mps,
+                from_deg,
+            } => format!("a steady wind of {speed_mps:.2} m/s from {from_deg:03.0}°"),
+            SimEffect::Current {
+                speed_mps,
+                towards_deg,
+            } => format!("a current of {speed_mps:.3} m/s setting towards {towards_deg:03.0}°"),
+            SimEffect::DeadBand { width_deg } => {
+                format!("a steering-gear dead band of {width_deg:.2}°")
+            }
         }
     }
 
@@ -234,6 +292,9 @@ impl SimEffect {
             } => {
                 check("speed_mps", speed_mps, speed_mps >= 0.0, ">= 0")?;
                 check("towards_deg", towards_deg, true, "finite")
+            }
+            SimEffect::DeadBand { width_deg: v } => {
+                check("width_deg", v, v > 0.0 && v <= 45.0, "in (0, 45] deg")
             }
         }
     }

@@ -365,9 +365,9 @@ pub fn simulate(ship: &Ship, scenario: &Scenario, seed: u64) -> Result<Record, S
     };
     let gyro_bias: f64 = effects
         .iter()
-        .map(|e| match e {
-            SimEffect::GyroBias { bias_degps } => *bias_degps,
-            _ => 0.0,
+        .filter_map(|e| match e {
+            SimEffect::GyroBias { bias_degps } => Some(*bias_degps),
+            _ => None,
         })
         .sum();
     let open = scenario.input.open_loop(n, ts, seed);

@@ -125,6 +125,7 @@ fn hidden_effects_cost_a_linear_model_fit_or_show_in_the_channels() {
         EffectKind::Saturation,
         EffectKind::Asymmetry,
         EffectKind::NonlinearDamping,
+        EffectKind::DeadBand,
     ] {
         let f = fits(&Scenario::with_effect(SimEffect::hidden(k, 1.0)));
         println!("{}: fit at 10/50 steps {f:.2?} %", k.name());

@@ -77,7 +77,10 @@ impl Layout {
                     heading = true;
                     gains.extend([Gain::CurS, Gain::CurC]);
                 }
-                Effect::DeadTime { .. } | Effect::RateLimit { .. } | Effect::Saturation { .. } => {}
+                Effect::DeadTime { .. }
+                | Effect::RateLimit { .. }
+                | Effect::Saturation { .. }
+                | Effect::DeadBand { .. } => {}
             }
         }
         let dy = gains
