@@ -14,7 +14,7 @@ use yawcast::io::export;
 use yawcast::sim::{Ship, SimEffect};
 use yawcast_shared::model::EffectKind;
 
-use super::common::{bad, check_record_for_model, read_model, JsonArg, ReadArgs, SeedArg};
+use super::common::{bad, check_record_for_model, read_model, JsonArg, Outputs, ReadArgs, SeedArg};
 
 /// Arguments of `yawcast augment`.
 #[derive(Debug, Args)]
@@ -238,6 +238,13 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
             "--null-reps 0: the null distributions need at least one replicate (default 40)",
         ));
     }
+    let (blob, _) = export::paths(&args.out);
+    let mut outputs = Outputs::check(&[
+        Some(blob.as_path()),
+        Some(twin.as_path()),
+        args.ship.as_deref(),
+        args.json.json.as_deref(),
+    ])?;
     // The ship file is read before any work: a broken one must not surface after the model
     // was written.
     if let Some(p) = args.ship.as_ref().filter(|p| p.exists()) {
@@ -264,7 +271,7 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
     };
     let cfg = AugmentConfig::default();
     let Some(kind) = kind else {
-        return write_unchanged(args, &given, &model, &est, &val, auto, &cfg);
+        return write_unchanged(args, outputs, &given, &model, &est, &val, auto, &cfg);
     };
     let t0 = std::time::Instant::now();
     let rep = augment::augment(&model, kind, &est, &val, &cfg).map_err(cli_err)?;
@@ -277,65 +284,87 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
         .first()
         .or(est.first())
         .context("no record to check the export on")?;
-    let ex = export::export(written, &args.out, check)
-        .with_context(|| format!("writing the model {}", args.out.display()))?;
-    println!(
+    let ex = add_export(&mut outputs, written, &args.out, check)?;
+    let mut done = vec![format!(
         "model written to {} and {}{}",
         ex.blob_path.display(),
         ex.json_path.display(),
         describe_written(what)
-    );
+    )];
 
     let mut ship_written = None;
     let mut sim_effect = None;
     if let Some(path) = &args.ship {
         if rep.kept {
             let eff = rep.model.effect(kind).copied();
-            let (ship, se) = write_ship(path, eff.as_ref(), &rep.model)?;
-            println!(
+            let (ship, se, text) = ship_with(path, eff.as_ref(), &rep.model)?;
+            outputs.add(path, text.into_bytes());
+            done.push(format!(
                 "ship file {} ({}) now carries {}",
                 path.display(),
                 ship.name,
                 describe_sim(&se)
-            );
+            ));
             ship_written = Some(path.clone());
             sim_effect = Some(se);
         } else {
-            println!(
+            done.push(format!(
                 "ship file {} left unchanged: the effect was not kept",
                 path.display()
-            );
+            ));
         }
     }
-    args.json.write(&AugmentSummary {
-        command: "augment",
-        effect: kind.name().to_string(),
-        auto,
-        kept: rep.kept,
-        written: what,
-        before: FitSummary {
-            fit: rep.before.clone(),
+    outputs.json(
+        &args.json,
+        &AugmentSummary {
+            command: "augment",
+            effect: kind.name().to_string(),
+            auto,
+            kept: rep.kept,
+            written: what,
+            before: FitSummary {
+                fit: rep.before.clone(),
+            },
+            baseline: FitSummary {
+                fit: rep.baseline.clone(),
+            },
+            after: FitSummary {
+                fit: rep.after.clone(),
+            },
+            fit_gain_pp: rep.fit_gain_pp,
+            delta_aic: rep.delta_aic,
+            delta_bic: rep.delta_bic,
+            ljung_box_p_before: rep.ljung_box_p_before,
+            ljung_box_p_after: rep.ljung_box_p_after,
+            estimated: rep.candidate.effect(kind).copied(),
+            std_pct: rep.std_pct.clone(),
+            explanation: rep.explanation.clone(),
+            out: ex.blob_path,
+            ship: ship_written,
+            sim_effect,
+            more: more.as_ref().map(MoreSummary::of),
+            effects: effect_names(written),
         },
-        baseline: FitSummary {
-            fit: rep.baseline.clone(),
-        },
-        after: FitSummary {
-            fit: rep.after.clone(),
-        },
-        fit_gain_pp: rep.fit_gain_pp,
-        delta_aic: rep.delta_aic,
-        delta_bic: rep.delta_bic,
-        ljung_box_p_before: rep.ljung_box_p_before,
-        ljung_box_p_after: rep.ljung_box_p_after,
-        estimated: rep.candidate.effect(kind).copied(),
-        std_pct: rep.std_pct.clone(),
-        explanation: rep.explanation.clone(),
-        out: ex.blob_path,
-        ship: ship_written,
-        sim_effect,
-        more: more.as_ref().map(MoreSummary::of),
-        effects: effect_names(written),
-    })
+    )?;
+    outputs.commit()?;
+    for d in done {
+        println!("{d}");
+    }
+    Ok(())
+}
+
+/// Adds the export of `model` (`<out>.postcard` and `<out>.json`, checked through the
+/// firmware on `check`) to `outputs`.
+fn add_export(
+    outputs: &mut Outputs,
+    model: &Model,
+    out: &Path,
+    check: &Record,
+) -> Result<export::ExportReport> {
+    let (report, files) = export::prepare_with(model, out, check, &export::ExportConfig::default())
+        .with_context(|| format!("exporting the model {}", out.display()))?;
+    outputs.extend(files);
+    Ok(report)
 }
 
 /// The `--more` search from `model` (`None` without `--more`), printed.
@@ -386,6 +415,7 @@ fn search_more(
 #[allow(clippy::too_many_arguments)]
 fn write_unchanged(
     args: &AugmentArgs,
+    mut outputs: Outputs,
     given: &Model,
     model: &Model,
     est: &[Record],
@@ -400,26 +430,25 @@ fn write_unchanged(
         .first()
         .or(est.first())
         .context("no record to check the export on")?;
-    let ex = export::export(written, &args.out, check)
-        .with_context(|| format!("writing the model {}", args.out.display()))?;
-    if what == Written::Input {
-        println!(
+    let ex = add_export(&mut outputs, written, &args.out, check)?;
+    let mut done = vec![if what == Written::Input {
+        format!(
             "no effect to add: the input model is written unchanged to {}",
             ex.blob_path.display()
-        );
+        )
     } else {
-        println!(
+        format!(
             "model written to {} and {}{}",
             ex.blob_path.display(),
             ex.json_path.display(),
             describe_written(what)
-        );
-    }
+        )
+    }];
     if let Some(p) = &args.ship {
-        println!(
+        done.push(format!(
             "ship file {} left unchanged (it only takes a named effect)",
             p.display()
-        );
+        ));
     }
     let searched = more.as_ref().is_some_and(|f| !f.added.is_empty());
     let explanation = match (auto, what) {
@@ -431,23 +460,31 @@ fn write_unchanged(
         (true, _) => "diagnose found no missing effect",
         (false, _) => "no effect named",
     };
-    args.json.write(&serde_json::json!({
-        "command": "augment",
-        "effect": "none",
-        "auto": auto,
-        "kept": false,
-        "written": what,
-        "before": serde_json::Value::Null,
-        "after": serde_json::Value::Null,
-        "fit_gain_pp": 0.0,
-        "delta_aic": serde_json::Value::Null,
-        "delta_bic": serde_json::Value::Null,
-        "explanation": explanation,
-        "out": ex.blob_path,
-        "ship": serde_json::Value::Null,
-        "more": more.as_ref().map(MoreSummary::of),
-        "effects": effect_names(written),
-    }))
+    outputs.json(
+        &args.json,
+        &serde_json::json!({
+            "command": "augment",
+            "effect": "none",
+            "auto": auto,
+            "kept": false,
+            "written": what,
+            "before": serde_json::Value::Null,
+            "after": serde_json::Value::Null,
+            "fit_gain_pp": 0.0,
+            "delta_aic": serde_json::Value::Null,
+            "delta_bic": serde_json::Value::Null,
+            "explanation": explanation,
+            "out": ex.blob_path,
+            "ship": serde_json::Value::Null,
+            "more": more.as_ref().map(MoreSummary::of),
+            "effects": effect_names(written),
+        }),
+    )?;
+    outputs.commit()?;
+    for d in done {
+        println!("{d}");
+    }
+    Ok(())
 }
 
 /// What the written model is against the model the user gave: `Augmented` when it carries
@@ -548,13 +585,13 @@ fn choose_auto(
     Ok((d.verdict_kind(), d.reference_gear))
 }
 
-/// Reads (or creates from the built-in ship) the ship file, adds the effect in physical
-/// units and writes it back atomically.
-fn write_ship(
+/// Reads (or creates from the built-in ship) the ship file and adds the effect in physical
+/// units; returns the ship, the effect and the file's new text.
+fn ship_with(
     path: &Path,
     effect: Option<&yawcast::identify::model::Effect>,
     model: &Model,
-) -> Result<(Ship, SimEffect)> {
+) -> Result<(Ship, SimEffect, String)> {
     let ship = if path.exists() {
         Ship::from_file(path).map_err(bad)?
     } else {
@@ -574,9 +611,7 @@ fn write_ship(
     })?;
     let ship = ship.with_effect(se);
     let text = ship.to_toml_string().map_err(bad)?;
-    yawcast::io::data::write_atomic(path, text.as_bytes())
-        .with_context(|| format!("writing the ship file {}", path.display()))?;
-    Ok((ship, se))
+    Ok((ship, se, text))
 }
 
 fn describe_sim(e: &SimEffect) -> String {
