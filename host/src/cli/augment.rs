@@ -387,24 +387,9 @@ fn search_more(
         t0.elapsed().as_secs_f64()
     );
     for (i, r) in f.rounds.iter().enumerate() {
-        let tried: Vec<String> = r
-            .tried
-            .iter()
-            .map(|t| {
-                format!(
-                    "{} {:+.2}{}",
-                    t.effect.name(),
-                    t.fit_gain_pp,
-                    if t.kept { "*" } else { "" }
-                )
-            })
-            .collect();
-        println!(
-            "  round {}: {} (pp at 10 steps; * kept) → {}",
-            i + 1,
-            tried.join(", "),
-            r.added.as_ref().map_or("none added", |a| a.effect.name())
-        );
+        for line in round_lines(i + 1, r) {
+            println!("{line}");
+        }
     }
     println!("{}", f.explanation);
     Ok(Some(f))
@@ -640,31 +625,133 @@ fn describe_sim(e: &SimEffect) -> String {
 }
 
 fn print_report(rep: &AugmentReport, secs: f64) {
-    println!(
+    for line in report_lines(rep, secs) {
+        println!("{line}");
+    }
+}
+
+/// A number for the terminal with `prec` decimals (`+` sign when `signed`), or "—" when it
+/// is not finite: an effect that could not be identified has no fit, and the line saying why
+/// follows it.
+fn num(v: f64, prec: usize, signed: bool) -> String {
+    match (v.is_finite(), signed) {
+        (false, _) => "—".into(),
+        (true, true) => format!("{v:+.prec$}"),
+        (true, false) => format!("{v:.prec$}"),
+    }
+}
+
+/// The lines of one round of `--more`: each effect tried with its held-out gain (or "—" and,
+/// on a line of its own, why it has none), and the one added.
+fn round_lines(number: usize, r: &augment::Round) -> Vec<String> {
+    let tried: Vec<String> = r
+        .tried
+        .iter()
+        .map(|t| {
+            format!(
+                "{} {}{}",
+                t.effect.name(),
+                num(t.fit_gain_pp, 2, true),
+                if t.kept { "*" } else { "" }
+            )
+        })
+        .collect();
+    let mut lines = vec![format!(
+        "  round {number}: {} (pp at 10 steps; * kept; — not identified) → {}",
+        tried.join(", "),
+        r.added.as_ref().map_or("none added", |a| a.effect.name())
+    )];
+    for t in r.tried.iter().filter(|t| !t.fit_gain_pp.is_finite()) {
+        let why = t
+            .note
+            .clone()
+            .unwrap_or_else(|| "not identified on these records".into());
+        lines.push(format!("    {} —: {why}", t.effect.name()));
+    }
+    lines
+}
+
+/// The lines of an augment report: fits per horizon before, with the baseline refit and
+/// after, then the verdict with its statistics ("—" for any that could not be computed).
+fn report_lines(rep: &AugmentReport, secs: f64) -> Vec<String> {
+    let mut lines = vec![format!(
         "{:>8} {:>10} {:>10} {:>10}",
         "horizon", "before", "baseline", "after"
-    );
+    )];
     let mut keys: Vec<&String> = rep.before.keys().collect();
     keys.sort_by_key(|k| yawcast::identify::predict::Horizon::parse(k));
+    let get = |m: &std::collections::BTreeMap<String, f64>, k: &str| {
+        num(m.get(k).copied().unwrap_or(f64::NAN), 2, false)
+    };
     for k in keys {
-        let b = rep.before[k];
-        println!(
-            "{:>8} {:>10.2} {:>10.2} {:>10.2}",
+        lines.push(format!(
+            "{:>8} {:>10} {:>10} {:>10}",
             k,
-            b,
-            rep.baseline.get(k).copied().unwrap_or(f64::NAN),
-            rep.after.get(k).copied().unwrap_or(f64::NAN)
-        );
+            get(&rep.before, k),
+            get(&rep.baseline, k),
+            get(&rep.after, k)
+        ));
     }
-    println!(
-        "{}: {} (ΔAIC {:+.1}, ΔBIC {:+.1}, Ljung–Box p {:.3} → {:.3}; {:.1} s)",
+    lines.push(format!(
+        "{}: {} (ΔAIC {}, ΔBIC {}, Ljung–Box p {} → {}; {:.1} s)",
         rep.effect.name(),
         if rep.kept { "kept" } else { "not kept" },
-        rep.delta_aic,
-        rep.delta_bic,
-        rep.ljung_box_p_before,
-        rep.ljung_box_p_after,
+        num(rep.delta_aic, 1, true),
+        num(rep.delta_bic, 1, true),
+        num(rep.ljung_box_p_before, 3, false),
+        num(rep.ljung_box_p_after, 3, false),
         secs
-    );
-    println!("{}", rep.explanation);
+    ));
+    lines.push(rep.explanation.clone());
+    lines
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tried(effect: EffectKind, gain: f64, note: Option<&str>) -> augment::Tried {
+        augment::Tried {
+            effect,
+            kept: false,
+            fit_10: gain + 80.0,
+            fit_gain_pp: gain,
+            delta_bic: if gain.is_finite() { -3.0 } else { f64::NAN },
+            note: note.map(String::from),
+        }
+    }
+
+    /// An effect that could not be identified (its fits NaN, as `augment` reports it) is
+    /// shown as "—" with the reason, never as "NaN".
+    #[test]
+    fn an_effect_without_a_fit_is_a_dash_with_its_reason_not_nan() {
+        let r = augment::Round {
+            tried: vec![
+                tried(EffectKind::Bias, 1.234, None),
+                tried(
+                    EffectKind::Saturation,
+                    f64::NAN,
+                    Some("an angle limit: not kept: the search found no stable model"),
+                ),
+                tried(EffectKind::DeadTime, f64::INFINITY, None),
+            ],
+            added: None,
+        };
+        let lines = round_lines(2, &r);
+        assert_eq!(
+            lines,
+            [
+                "  round 2: bias +1.23, saturation —, dead-time — (pp at 10 steps; * kept; — \
+                 not identified) → none added",
+                "    saturation —: an angle limit: not kept: the search found no stable model",
+                "    dead-time —: not identified on these records",
+            ]
+        );
+        assert!(lines
+            .iter()
+            .all(|l| !l.contains("NaN") && !l.contains("inf")));
+        assert_eq!(num(f64::NAN, 2, true), "—");
+        assert_eq!(num(-0.0, 1, true), "-0.0");
+        assert_eq!(num(0.126, 2, false), "0.13");
+    }
 }
