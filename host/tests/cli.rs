@@ -370,22 +370,35 @@ fn qemu_elf() -> Option<PathBuf> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()?
         .to_path_buf();
-    let mut c: Vec<PathBuf> = std::env::var_os("YAWCAST_FW_ELF")
-        .map(PathBuf::from)
-        .into_iter()
-        .collect();
-    for sub in ["target", "target/thumb"] {
-        c.push(
-            root.join(sub)
-                .join("thumbv7em-none-eabihf/release/yawcast-fw"),
-        );
-    }
+    // The ELF named by YAWCAST_FW_ELF, when set, and no other.
+    let c: Vec<PathBuf> = match std::env::var_os("YAWCAST_FW_ELF") {
+        Some(p) => vec![PathBuf::from(p)],
+        None => ["target", "target/thumb"]
+            .iter()
+            .map(|sub| {
+                root.join(sub)
+                    .join("thumbv7em-none-eabihf/release/yawcast-fw")
+            })
+            .collect(),
+    };
     c.into_iter().find(|p| p.is_file())
 }
 
 #[test]
 fn hil_in_qemu_is_bit_exact() {
     let Some(elf) = qemu_elf() else {
+        // In CI, or wherever a firmware ELF is named, the QEMU run is required: a missing
+        // QEMU or ELF there is a failure, not a skip.
+        let required = ["CI", "YAWCAST_FW_ELF"]
+            .into_iter()
+            .filter(|v| std::env::var_os(v).is_some_and(|x| !x.is_empty()))
+            .collect::<Vec<_>>();
+        assert!(
+            required.is_empty(),
+            "{} set but no qemu-system-arm or no firmware ELF (YAWCAST_FW_ELF = {:?})",
+            required.join(" and "),
+            std::env::var_os("YAWCAST_FW_ELF")
+        );
         eprintln!("hil_in_qemu_is_bit_exact: skipped (no qemu-system-arm or no firmware ELF)");
         return;
     };
