@@ -2079,7 +2079,8 @@ fn a_write_failing_after_the_first_output_leaves_none() {
 /// SIGTERM or SIGINT arriving between two renames of the outputs (the write paused there by
 /// `YAWCAST_TEST_PAUSE_RENAME` until the signal comes, so the moment is certain): the new
 /// JSON twin already renamed is taken back, the old blob and twin are as they were, no
-/// temporary file or backup is left, and the exit code is 128 + the signal.
+/// temporary file or backup is left, and the exit code is 128 + the signal — for `export`
+/// and for `tune`.
 #[test]
 fn a_signal_during_the_write_rolls_back_and_exits_128_plus_the_signal() {
     let d = scratch("signal");
@@ -2132,6 +2133,67 @@ fn a_signal_during_the_write_rolls_back_and_exits_128_plus_the_signal() {
         );
         assert!(tree(&out) == before, "SIG{signal}: outputs changed");
     }
+    // tune's five outputs (blob, twin, both tables, summary), interrupted after the first.
+    let t = d.join("tune");
+    let sim = run(&[
+        "simulate",
+        "--duration",
+        "600",
+        "--records",
+        "2",
+        "--seed",
+        "1",
+        "--out",
+        t.join("sim.csv").to_str().unwrap(),
+    ]);
+    assert_eq!(code(&sim), 0, "{}", stderr(&sim));
+    let tune = |data: &str, validate: &str| -> Command {
+        let mut c = bin();
+        c.args(["tune", "--generations", "2", "--order", "2", "--seed", "3"]);
+        c.arg("--data").arg(t.join(data));
+        c.arg("--validate").arg(t.join(validate));
+        c.arg("--out").arg(t.join("out/ship"));
+        c.arg("--json").arg(t.join("out/summary.json"));
+        c
+    };
+    let o = tune("sim-1.csv", "sim-2.csv").output().unwrap();
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let before = tree(&t.join("out"));
+    assert_eq!(
+        before.len(),
+        5,
+        "{:?}",
+        before.iter().map(|f| &f.0).collect::<Vec<_>>()
+    );
+    let marker = t.join("paused");
+    let mut child = tune("sim-2.csv", "sim-1.csv")
+        .env("YAWCAST_TEST_PAUSE_RENAME", &marker)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut polls = 0;
+    while !marker.exists() {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "tune ended before its write"
+        );
+        assert!(polls < 60_000, "tune's write never paused");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+        polls += 1;
+    }
+    assert!(
+        tree(&t.join("out")) != before,
+        "nothing renamed before the pause"
+    );
+    let k = Command::new("kill")
+        .args(["-INT".to_string(), child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(k.success());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(code(&o), 130, "{}", stderr(&o));
+    assert!(tree(&t.join("out")) == before, "tune's outputs changed");
 }
 
 /// The exit-code contract, one table: 0 success, 2 bad input or arguments (the run names
