@@ -407,6 +407,23 @@ impl Tables {
 
     /// The two files of [`Tables::write`] with their bytes, for a caller that writes them
     /// together with its other outputs.
+    ///
+    /// ```
+    /// use std::path::Path;
+    /// use yawcast::{io::data::Record, identify::model::Model, identify::predict, tune::tables::{Column, Tables}};
+    /// let m = Model::new(1.0, vec![0.0, 0.5], vec![1.0, 0.5], vec![0.1, 0.0]).unwrap();
+    /// let u: Vec<f64> = (0..200).map(|i| if i % 9 < 4 { 1.0 } else { -1.0 }).collect();
+    /// let mut r = Record::from_uy("lake", 1.0, u, vec![0.0; 200]);
+    /// r.y = predict::simulate(&m, &r, &[0.0, 0.0]);
+    /// let col = |label: &str| Column { label: label.into(), model: m.clone(), std: vec![0.01; 6], r: None, lambda: None };
+    /// let t = Tables::compare(&col("conventional"), &col("GA-tuned"), &[r]).unwrap();
+    /// let files = t.files(Path::new("runs/ship"));
+    /// assert_eq!(files[0].0, Path::new("runs/ship.tables.md"));
+    /// assert_eq!(files[0].1, t.to_markdown().into_bytes());
+    /// assert_eq!(files[1].0, Path::new("runs/ship.tables.json"));
+    /// let v: serde_json::Value = serde_json::from_slice(&files[1].1).unwrap();
+    /// assert_eq!(v["trial_records"], 1);
+    /// ```
     pub fn files(&self, out: &Path) -> Vec<(PathBuf, Vec<u8>)> {
         let (md, js) = Self::paths(out);
         let json = serde_json::to_string_pretty(self).unwrap_or_else(|_| "{}".into());
