@@ -2206,6 +2206,8 @@ fn exit_codes_follow_one_contract() {
     std::fs::write(d.join("good2.csv"), csv4(400, 2, 0.02)).unwrap();
     std::fs::write(d.join("short.csv"), csv_text(300, 0.5)).unwrap();
     std::fs::write(d.join("file"), b"a file").unwrap();
+    std::fs::create_dir_all(d.join("sub")).unwrap();
+    std::fs::write(d.join("sub/short.csv"), csv_text(300, 0.5)).unwrap();
     // A valid, stable model whose gain is 10⁴ times the records': its simulation runs off
     // the record (fit about −10⁶ %), a numerical failure, not a result to print.
     std::fs::write(
@@ -2231,6 +2233,7 @@ fn exit_codes_follow_one_contract() {
         ("export, --golden is a directory", 2, "export --model {model} --data {d}/short.csv --out {d}/exp2 --golden {d}"),
         ("compare", 0, "compare --model {model} --data {d}/short.csv --out {d}/series --json {d}/cmp.json"),
         ("compare, diverging model", 1, "compare --model {d}/wild.json --data {d}/short.csv --horizons sim"),
+        ("compare, two records of one name", 2, "compare --model {model} --data {d}/short.csv --data {d}/sub/short.csv --out {d}/series2"),
         ("compare, missing model", 2, "compare --model {d}/nowhere.json --data {d}/short.csv"),
         ("resid", 0, "resid --model {model} --data {d}/short.csv --out {d}/plots"),
         ("resid, --max-lag 0", 2, "resid --model {model} --data {d}/short.csv --max-lag 0"),
@@ -2285,6 +2288,7 @@ fn exit_codes_follow_one_contract() {
         assert!(d.join(f).exists(), "{f} missing");
     }
     for f in [
+        "series2",
         "x.csv",
         "exp2.postcard",
         "aug2.postcard",

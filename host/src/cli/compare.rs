@@ -11,8 +11,8 @@ use yawcast::identify::predict::{self, Horizon};
 use yawcast::io::data::Record;
 
 use super::common::{
-    check_fit, check_horizons_fit, check_record_for_model, parse_horizons, read_model, JsonArg,
-    Outputs, ReadArgs,
+    bad, check_fit, check_horizons_fit, check_record_for_model, parse_horizons, read_model,
+    JsonArg, Outputs, ReadArgs,
 };
 
 /// The horizons compared when `--horizons` is not given (those not shorter than a record are
@@ -78,6 +78,25 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         let rec = args.read.read(p)?;
         check_record_for_model(&rec, &model, p)?;
         records.push(rec);
+    }
+    if args.out.is_some() {
+        // One series file per record, named after it: two records of one name would share it.
+        for (i, (r, p)) in records.iter().zip(&args.data).enumerate() {
+            if let Some(q) = records[..i]
+                .iter()
+                .zip(&args.data)
+                .find_map(|(o, q)| (o.name == r.name).then_some(q))
+            {
+                return Err(bad(format!(
+                    "{} and {}: both records are named `{}`, so their series would go to one \
+                     file {}.compare.csv under --out; rename one",
+                    q.display(),
+                    p.display(),
+                    r.name,
+                    r.name
+                )));
+            }
+        }
     }
     let horizons = if args.horizons == DEFAULT_HORIZONS {
         // The default horizons shrink to what short records can hold, with a word.
