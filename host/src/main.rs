@@ -1,5 +1,7 @@
-//! The `yawcast` command-line tool: exit code 0 on success, 2 on bad input, 1 otherwise.
+//! The `yawcast` command-line tool: exit code 0 on success, 2 on bad input, 1 otherwise;
+//! 130 (SIGINT) or 143 (SIGTERM) when interrupted, with no output half-written.
 
+use std::io::Write;
 use std::process::ExitCode;
 
 use clap::Parser;
@@ -16,11 +18,18 @@ fn main() -> ExitCode {
             return ExitCode::from(code);
         }
     };
+    interrupt_on_signals();
     match cli::run(parsed) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
+            if let Some(signal) = err.chain().find_map(|c| match c.downcast_ref() {
+                Some(yawcast::io::data::DataError::Interrupted { signal }) => Some(*signal),
+                _ => None,
+            }) {
+                exit_interrupted(signal);
+            }
             // One line with the whole cause chain first, then nothing else to scroll past.
-            eprintln!("error: {}", one_line(&err));
+            let _ = writeln!(std::io::stderr(), "error: {}", one_line(&err));
             if cli::common::is_bad_input(&err) {
                 ExitCode::from(2)
             } else {
@@ -28,6 +37,46 @@ fn main() -> ExitCode {
             }
         }
     }
+}
+
+/// SIGINT and SIGTERM end the process with 128 + the signal once no output is being written:
+/// a write of outputs in progress rolls back (or, past its last rename, finishes) first,
+/// under the lock of [`yawcast::io::data::OUTPUTS`], so no temporary file, backup or part
+/// of a command's outputs is left.
+fn interrupt_on_signals() {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM]) else {
+        // Without the handler the signals keep their default action (no worse than before).
+        return;
+    };
+    std::thread::spawn(move || {
+        if let Some(signal) = signals.forever().next() {
+            let _no_more_writes = yawcast::io::data::OUTPUTS.interrupt(signal);
+            exit_interrupted(signal);
+        }
+    });
+}
+
+/// Reports the interruption once (the signal thread and the main thread may both get here)
+/// and exits with 128 + the signal.
+fn exit_interrupted(signal: i32) -> ! {
+    static REPORTED: std::sync::Once = std::sync::Once::new();
+    // The first caller exits inside `call_once`; a second one waits there until it has.
+    REPORTED.call_once(|| {
+        let name = match signal {
+            2 => "SIGINT",
+            15 => "SIGTERM",
+            _ => "a signal",
+        };
+        // Not `eprintln!`: with stderr closed (its reader gone) that panics, and the process
+        // would go on running without its signal handler.
+        let _ = writeln!(
+            std::io::stderr(),
+            "error: interrupted by {name}: outputs not yet renamed into place were rolled back"
+        );
+        std::process::exit(128 + signal)
+    });
+    std::process::exit(128 + signal)
 }
 
 /// The cause chain on one line, each cause once: an error whose text already holds its

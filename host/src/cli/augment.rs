@@ -14,7 +14,7 @@ use yawcast::io::export;
 use yawcast::sim::{Ship, SimEffect};
 use yawcast_shared::model::EffectKind;
 
-use super::common::{bad, check_record_for_model, read_model, JsonArg, ReadArgs, SeedArg};
+use super::common::{bad, check_record_for_model, read_model, JsonArg, Outputs, ReadArgs, SeedArg};
 
 /// Arguments of `yawcast augment`.
 #[derive(Debug, Args)]
@@ -238,6 +238,13 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
             "--null-reps 0: the null distributions need at least one replicate (default 40)",
         ));
     }
+    let (blob, _) = export::paths(&args.out);
+    let mut outputs = Outputs::check(&[
+        Some(blob.as_path()),
+        Some(twin.as_path()),
+        args.ship.as_deref(),
+        args.json.json.as_deref(),
+    ])?;
     // The ship file is read before any work: a broken one must not surface after the model
     // was written.
     if let Some(p) = args.ship.as_ref().filter(|p| p.exists()) {
@@ -264,7 +271,7 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
     };
     let cfg = AugmentConfig::default();
     let Some(kind) = kind else {
-        return write_unchanged(args, &given, &model, &est, &val, auto, &cfg);
+        return write_unchanged(args, outputs, &given, &model, &est, &val, auto, &cfg);
     };
     let t0 = std::time::Instant::now();
     let rep = augment::augment(&model, kind, &est, &val, &cfg).map_err(cli_err)?;
@@ -277,65 +284,87 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
         .first()
         .or(est.first())
         .context("no record to check the export on")?;
-    let ex = export::export(written, &args.out, check)
-        .with_context(|| format!("writing the model {}", args.out.display()))?;
-    println!(
+    let ex = add_export(&mut outputs, written, &args.out, check)?;
+    let mut done = vec![format!(
         "model written to {} and {}{}",
         ex.blob_path.display(),
         ex.json_path.display(),
         describe_written(what)
-    );
+    )];
 
     let mut ship_written = None;
     let mut sim_effect = None;
     if let Some(path) = &args.ship {
         if rep.kept {
             let eff = rep.model.effect(kind).copied();
-            let (ship, se) = write_ship(path, eff.as_ref(), &rep.model)?;
-            println!(
+            let (ship, se, text) = ship_with(path, eff.as_ref(), &rep.model)?;
+            outputs.add(path, text.into_bytes());
+            done.push(format!(
                 "ship file {} ({}) now carries {}",
                 path.display(),
                 ship.name,
                 se.describe()
-            );
+            ));
             ship_written = Some(path.clone());
             sim_effect = Some(se);
         } else {
-            println!(
+            done.push(format!(
                 "ship file {} left unchanged: the effect was not kept",
                 path.display()
-            );
+            ));
         }
     }
-    args.json.write(&AugmentSummary {
-        command: "augment",
-        effect: kind.name().to_string(),
-        auto,
-        kept: rep.kept,
-        written: what,
-        before: FitSummary {
-            fit: rep.before.clone(),
+    outputs.json(
+        &args.json,
+        &AugmentSummary {
+            command: "augment",
+            effect: kind.name().to_string(),
+            auto,
+            kept: rep.kept,
+            written: what,
+            before: FitSummary {
+                fit: rep.before.clone(),
+            },
+            baseline: FitSummary {
+                fit: rep.baseline.clone(),
+            },
+            after: FitSummary {
+                fit: rep.after.clone(),
+            },
+            fit_gain_pp: rep.fit_gain_pp,
+            delta_aic: rep.delta_aic,
+            delta_bic: rep.delta_bic,
+            ljung_box_p_before: rep.ljung_box_p_before,
+            ljung_box_p_after: rep.ljung_box_p_after,
+            estimated: rep.candidate.effect(kind).copied(),
+            std_pct: rep.std_pct.clone(),
+            explanation: rep.explanation.clone(),
+            out: ex.blob_path,
+            ship: ship_written,
+            sim_effect,
+            more: more.as_ref().map(MoreSummary::of),
+            effects: effect_names(written),
         },
-        baseline: FitSummary {
-            fit: rep.baseline.clone(),
-        },
-        after: FitSummary {
-            fit: rep.after.clone(),
-        },
-        fit_gain_pp: rep.fit_gain_pp,
-        delta_aic: rep.delta_aic,
-        delta_bic: rep.delta_bic,
-        ljung_box_p_before: rep.ljung_box_p_before,
-        ljung_box_p_after: rep.ljung_box_p_after,
-        estimated: rep.candidate.effect(kind).copied(),
-        std_pct: rep.std_pct.clone(),
-        explanation: rep.explanation.clone(),
-        out: ex.blob_path,
-        ship: ship_written,
-        sim_effect,
-        more: more.as_ref().map(MoreSummary::of),
-        effects: effect_names(written),
-    })
+    )?;
+    outputs.commit()?;
+    for d in done {
+        println!("{d}");
+    }
+    Ok(())
+}
+
+/// Adds the export of `model` (`<out>.postcard` and `<out>.json`, checked through the
+/// firmware on `check`) to `outputs`.
+fn add_export(
+    outputs: &mut Outputs,
+    model: &Model,
+    out: &Path,
+    check: &Record,
+) -> Result<export::ExportReport> {
+    let (report, files) = export::prepare_with(model, out, check, &export::ExportConfig::default())
+        .with_context(|| format!("exporting the model {}", out.display()))?;
+    outputs.extend(files);
+    Ok(report)
 }
 
 /// The `--more` search from `model` (`None` without `--more`), printed.
@@ -358,24 +387,9 @@ fn search_more(
         t0.elapsed().as_secs_f64()
     );
     for (i, r) in f.rounds.iter().enumerate() {
-        let tried: Vec<String> = r
-            .tried
-            .iter()
-            .map(|t| {
-                format!(
-                    "{} {:+.2}{}",
-                    t.effect.name(),
-                    t.fit_gain_pp,
-                    if t.kept { "*" } else { "" }
-                )
-            })
-            .collect();
-        println!(
-            "  round {}: {} (pp at 10 steps; * kept) → {}",
-            i + 1,
-            tried.join(", "),
-            r.added.as_ref().map_or("none added", |a| a.effect.name())
-        );
+        for line in round_lines(i + 1, r) {
+            println!("{line}");
+        }
     }
     println!("{}", f.explanation);
     Ok(Some(f))
@@ -386,6 +400,7 @@ fn search_more(
 #[allow(clippy::too_many_arguments)]
 fn write_unchanged(
     args: &AugmentArgs,
+    mut outputs: Outputs,
     given: &Model,
     model: &Model,
     est: &[Record],
@@ -400,26 +415,25 @@ fn write_unchanged(
         .first()
         .or(est.first())
         .context("no record to check the export on")?;
-    let ex = export::export(written, &args.out, check)
-        .with_context(|| format!("writing the model {}", args.out.display()))?;
-    if what == Written::Input {
-        println!(
+    let ex = add_export(&mut outputs, written, &args.out, check)?;
+    let mut done = vec![if what == Written::Input {
+        format!(
             "no effect to add: the input model is written unchanged to {}",
             ex.blob_path.display()
-        );
+        )
     } else {
-        println!(
+        format!(
             "model written to {} and {}{}",
             ex.blob_path.display(),
             ex.json_path.display(),
             describe_written(what)
-        );
-    }
+        )
+    }];
     if let Some(p) = &args.ship {
-        println!(
+        done.push(format!(
             "ship file {} left unchanged (it only takes a named effect)",
             p.display()
-        );
+        ));
     }
     let searched = more.as_ref().is_some_and(|f| !f.added.is_empty());
     let explanation = match (auto, what) {
@@ -431,23 +445,31 @@ fn write_unchanged(
         (true, _) => "diagnose found no missing effect",
         (false, _) => "no effect named",
     };
-    args.json.write(&serde_json::json!({
-        "command": "augment",
-        "effect": "none",
-        "auto": auto,
-        "kept": false,
-        "written": what,
-        "before": serde_json::Value::Null,
-        "after": serde_json::Value::Null,
-        "fit_gain_pp": 0.0,
-        "delta_aic": serde_json::Value::Null,
-        "delta_bic": serde_json::Value::Null,
-        "explanation": explanation,
-        "out": ex.blob_path,
-        "ship": serde_json::Value::Null,
-        "more": more.as_ref().map(MoreSummary::of),
-        "effects": effect_names(written),
-    }))
+    outputs.json(
+        &args.json,
+        &serde_json::json!({
+            "command": "augment",
+            "effect": "none",
+            "auto": auto,
+            "kept": false,
+            "written": what,
+            "before": serde_json::Value::Null,
+            "after": serde_json::Value::Null,
+            "fit_gain_pp": 0.0,
+            "delta_aic": serde_json::Value::Null,
+            "delta_bic": serde_json::Value::Null,
+            "explanation": explanation,
+            "out": ex.blob_path,
+            "ship": serde_json::Value::Null,
+            "more": more.as_ref().map(MoreSummary::of),
+            "effects": effect_names(written),
+        }),
+    )?;
+    outputs.commit()?;
+    for d in done {
+        println!("{d}");
+    }
+    Ok(())
 }
 
 /// What the written model is against the model the user gave: `Augmented` when it carries
@@ -548,13 +570,13 @@ fn choose_auto(
     Ok((d.verdict_kind(), d.reference_gear))
 }
 
-/// Reads (or creates from the built-in ship) the ship file, adds the effect in physical
-/// units and writes it back atomically.
-fn write_ship(
+/// Reads (or creates from the built-in ship) the ship file and adds the effect in physical
+/// units; returns the ship, the effect and the file's new text.
+fn ship_with(
     path: &Path,
     effect: Option<&yawcast::identify::model::Effect>,
     model: &Model,
-) -> Result<(Ship, SimEffect)> {
+) -> Result<(Ship, SimEffect, String)> {
     let ship = if path.exists() {
         Ship::from_file(path).map_err(bad)?
     } else {
@@ -574,37 +596,137 @@ fn write_ship(
     })?;
     let ship = ship.with_effect(se);
     let text = ship.to_toml_string().map_err(bad)?;
-    yawcast::io::data::write_atomic(path, text.as_bytes())
-        .with_context(|| format!("writing the ship file {}", path.display()))?;
-    Ok((ship, se))
+    Ok((ship, se, text))
 }
 
 fn print_report(rep: &AugmentReport, secs: f64) {
-    println!(
+    for line in report_lines(rep, secs) {
+        println!("{line}");
+    }
+}
+
+/// A number for the terminal with `prec` decimals (`+` sign when `signed`), or "—" when it
+/// is not finite: an effect that could not be identified has no fit, and the line saying why
+/// follows it.
+fn num(v: f64, prec: usize, signed: bool) -> String {
+    match (v.is_finite(), signed) {
+        (false, _) => "—".into(),
+        (true, true) => format!("{v:+.prec$}"),
+        (true, false) => format!("{v:.prec$}"),
+    }
+}
+
+/// The lines of one round of `--more`: each effect tried with its held-out gain (or "—" and,
+/// on a line of its own, why it has none), and the one added.
+fn round_lines(number: usize, r: &augment::Round) -> Vec<String> {
+    let tried: Vec<String> = r
+        .tried
+        .iter()
+        .map(|t| {
+            format!(
+                "{} {}{}",
+                t.effect.name(),
+                num(t.fit_gain_pp, 2, true),
+                if t.kept { "*" } else { "" }
+            )
+        })
+        .collect();
+    let mut lines = vec![format!(
+        "  round {number}: {} (pp at 10 steps; * kept; — not identified) → {}",
+        tried.join(", "),
+        r.added.as_ref().map_or("none added", |a| a.effect.name())
+    )];
+    for t in r.tried.iter().filter(|t| !t.fit_gain_pp.is_finite()) {
+        let why = t
+            .note
+            .clone()
+            .unwrap_or_else(|| "not identified on these records".into());
+        lines.push(format!("    {} —: {why}", t.effect.name()));
+    }
+    lines
+}
+
+/// The lines of an augment report: fits per horizon before, with the baseline refit and
+/// after, then the verdict with its statistics ("—" for any that could not be computed).
+fn report_lines(rep: &AugmentReport, secs: f64) -> Vec<String> {
+    let mut lines = vec![format!(
         "{:>8} {:>10} {:>10} {:>10}",
         "horizon", "before", "baseline", "after"
-    );
+    )];
     let mut keys: Vec<&String> = rep.before.keys().collect();
     keys.sort_by_key(|k| yawcast::identify::predict::Horizon::parse(k));
+    let get = |m: &std::collections::BTreeMap<String, f64>, k: &str| {
+        num(m.get(k).copied().unwrap_or(f64::NAN), 2, false)
+    };
     for k in keys {
-        let b = rep.before[k];
-        println!(
-            "{:>8} {:>10.2} {:>10.2} {:>10.2}",
+        lines.push(format!(
+            "{:>8} {:>10} {:>10} {:>10}",
             k,
-            b,
-            rep.baseline.get(k).copied().unwrap_or(f64::NAN),
-            rep.after.get(k).copied().unwrap_or(f64::NAN)
-        );
+            get(&rep.before, k),
+            get(&rep.baseline, k),
+            get(&rep.after, k)
+        ));
     }
-    println!(
-        "{}: {} (ΔAIC {:+.1}, ΔBIC {:+.1}, Ljung–Box p {:.3} → {:.3}; {:.1} s)",
+    lines.push(format!(
+        "{}: {} (ΔAIC {}, ΔBIC {}, Ljung–Box p {} → {}; {:.1} s)",
         rep.effect.name(),
         if rep.kept { "kept" } else { "not kept" },
-        rep.delta_aic,
-        rep.delta_bic,
-        rep.ljung_box_p_before,
-        rep.ljung_box_p_after,
+        num(rep.delta_aic, 1, true),
+        num(rep.delta_bic, 1, true),
+        num(rep.ljung_box_p_before, 3, false),
+        num(rep.ljung_box_p_after, 3, false),
         secs
-    );
-    println!("{}", rep.explanation);
+    ));
+    lines.push(rep.explanation.clone());
+    lines
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tried(effect: EffectKind, gain: f64, note: Option<&str>) -> augment::Tried {
+        augment::Tried {
+            effect,
+            kept: false,
+            fit_10: gain + 80.0,
+            fit_gain_pp: gain,
+            delta_bic: if gain.is_finite() { -3.0 } else { f64::NAN },
+            note: note.map(String::from),
+        }
+    }
+
+    /// An effect that could not be identified (its fits NaN, as `augment` reports it) is
+    /// shown as "—" with the reason, never as "NaN".
+    #[test]
+    fn an_effect_without_a_fit_is_a_dash_with_its_reason_not_nan() {
+        let r = augment::Round {
+            tried: vec![
+                tried(EffectKind::Bias, 1.234, None),
+                tried(
+                    EffectKind::Saturation,
+                    f64::NAN,
+                    Some("an angle limit: not kept: the search found no stable model"),
+                ),
+                tried(EffectKind::DeadTime, f64::INFINITY, None),
+            ],
+            added: None,
+        };
+        let lines = round_lines(2, &r);
+        assert_eq!(
+            lines,
+            [
+                "  round 2: bias +1.23, saturation —, dead-time — (pp at 10 steps; * kept; — \
+                 not identified) → none added",
+                "    saturation —: an angle limit: not kept: the search found no stable model",
+                "    dead-time —: not identified on these records",
+            ]
+        );
+        assert!(lines
+            .iter()
+            .all(|l| !l.contains("NaN") && !l.contains("inf")));
+        assert_eq!(num(f64::NAN, 2, true), "—");
+        assert_eq!(num(-0.0, 1, true), "-0.0");
+        assert_eq!(num(0.126, 2, false), "0.13");
+    }
 }

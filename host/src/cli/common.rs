@@ -211,7 +211,16 @@ impl ReadArgs {
     pub fn read(&self, path: &Path) -> Result<Record> {
         let bytes = std::fs::read(path)
             .map_err(|e| bad(format!("{}: cannot read: {e}", path.display())))?;
-        let text = String::from_utf8_lossy(&bytes);
+        let rec = self.parse(&bytes, path)?;
+        for w in data::unit_warnings(&rec) {
+            eprintln!("warning: {}: {w}", path.display());
+        }
+        Ok(rec)
+    }
+
+    /// [`ReadArgs::read`] on the bytes of `path` (already read), without the unit warnings.
+    pub fn parse(&self, bytes: &[u8], path: &Path) -> Result<Record> {
+        let text = String::from_utf8_lossy(bytes);
         let name = path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
@@ -243,9 +252,6 @@ impl ReadArgs {
             (data::parse_csv(&text, path, &name, &cols)?, cols)
         };
         data::validate_record(&rec, path, &self.limits()?, &cols)?;
-        for w in data::unit_warnings(&rec) {
-            eprintln!("warning: {}: {w}", path.display());
-        }
         Ok(rec)
     }
 
@@ -268,12 +274,97 @@ pub struct JsonArg {
 }
 
 impl JsonArg {
-    /// Writes `value` as pretty JSON, atomically, when `--json` was given.
+    /// Writes `value` as pretty JSON, atomically, when `--json` was given (a command whose
+    /// only output it is; others add it to their [`Outputs`]).
     pub fn write<T: Serialize>(&self, value: &T) -> Result<()> {
-        if let Some(p) = &self.json {
-            write_json(p, value)?;
+        let mut out = Outputs::check(&[self.json.as_deref()])?;
+        out.json(self, value)?;
+        out.commit()
+    }
+}
+
+/// Names the variable that makes the `n`-th rename of a command's outputs fail (fault
+/// injection for the all-or-nothing tests; `0` or unset: no fault).
+pub const FAIL_RENAME_VAR: &str = "YAWCAST_TEST_FAIL_RENAME";
+
+/// Names the variable holding a path: after its first rename, the outputs' write creates
+/// that file and waits (up to a minute) for a signal, which then rolls the write back
+/// (for the interruption tests).
+pub const PAUSE_RENAME_VAR: &str = "YAWCAST_TEST_PAUSE_RENAME";
+
+/// A command's outputs: every path checked before any work ([`Outputs::check`]), the bytes
+/// gathered as they are made, and all written together or none at the end
+/// ([`Outputs::commit`]).
+#[derive(Debug, Default)]
+pub struct Outputs {
+    files: Vec<(PathBuf, Vec<u8>)>,
+}
+
+impl Outputs {
+    /// Checks the output paths (`None`: an output not asked for) and starts an empty set.
+    /// Errors as bad input (exit 2) naming the path that cannot be written.
+    pub fn check(paths: &[Option<&Path>]) -> Result<Outputs> {
+        let paths: Vec<&Path> = paths.iter().flatten().copied().collect();
+        data::check_outputs(&paths).map_err(|e| bad(format!("output {e}")))?;
+        Ok(Outputs::default())
+    }
+
+    /// Adds a file.
+    pub fn add(&mut self, path: &Path, bytes: Vec<u8>) {
+        self.files.push((path.to_path_buf(), bytes));
+    }
+
+    /// Adds several files.
+    pub fn extend(&mut self, files: Vec<(PathBuf, Vec<u8>)>) {
+        self.files.extend(files);
+    }
+
+    /// Adds the `--json` summary, when asked for.
+    pub fn json<T: Serialize>(&mut self, arg: &JsonArg, value: &T) -> Result<()> {
+        if let Some(p) = &arg.json {
+            self.add(p, json_bytes(value)?);
         }
         Ok(())
+    }
+
+    /// Writes every output, all together or none. A failure here (the paths were checked)
+    /// is not the input's fault: exit 1; an interruption by a signal keeps its own error
+    /// (exit 128 + the signal).
+    pub fn commit(self) -> Result<()> {
+        if self.files.is_empty() {
+            return Ok(());
+        }
+        let fail_at: usize = std::env::var(FAIL_RENAME_VAR)
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(0);
+        let pause = std::env::var_os(PAUSE_RENAME_VAR).map(PathBuf::from);
+        let mut calls = 0usize;
+        let res = data::write_all_atomic_with(&self.files, &mut |from, to| {
+            calls += 1;
+            if calls == fail_at {
+                return Err(std::io::Error::other(format!(
+                    "rename {calls} failed ({FAIL_RENAME_VAR})"
+                )));
+            }
+            std::fs::rename(from, to)?;
+            if let (1, Some(marker)) = (calls, &pause) {
+                std::fs::write(marker, b"")?;
+                let mut waited = 0;
+                while data::OUTPUTS.interrupted().is_none() && waited < 6000 {
+                    std::thread::sleep(std::time::Duration::from_millis(10));
+                    waited += 1;
+                }
+            }
+            Ok(())
+        });
+        match res {
+            Ok(()) => Ok(()),
+            Err(e @ data::DataError::Interrupted { .. }) => Err(anyhow::Error::new(e)),
+            Err(e) => Err(anyhow::anyhow!(
+                "writing the outputs failed, none was written (files they would have replaced keep their content): {e}"
+            )),
+        }
     }
 }
 
@@ -282,14 +373,6 @@ pub fn json_bytes<T: Serialize>(value: &T) -> Result<Vec<u8>> {
     let mut bytes = serde_json::to_vec_pretty(value).context("serialising the JSON summary")?;
     bytes.push(b'\n');
     Ok(bytes)
-}
-
-/// Writes `value` as pretty JSON to `path`, atomically.
-pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<()> {
-    let mut bytes = serde_json::to_vec_pretty(value).context("serialising the JSON summary")?;
-    bytes.push(b'\n');
-    data::write_atomic(path, &bytes)
-        .with_context(|| format!("writing the JSON summary {}", path.display()))
 }
 
 /// `--seed N`: the seed of every random choice; when not given, derived from the records
@@ -376,12 +459,18 @@ pub fn progress(len: u64, msg: &str) -> indicatif::ProgressBar {
 pub fn read_model(path: &Path) -> Result<Model> {
     let bytes = std::fs::read(path)
         .map_err(|e| bad(format!("{}: cannot read the model: {e}", path.display())))?;
+    model_from_bytes(&bytes, path)
+}
+
+/// [`read_model`] on the bytes of `path` (already read): a `.json` twin, or a blob with the
+/// twin beside it consulted as [`read_model`] does.
+pub fn model_from_bytes(bytes: &[u8], path: &Path) -> Result<Model> {
     let is_json = path.extension().is_some_and(|e| e == "json");
     if is_json {
-        return model_from_json(&bytes, path);
+        return model_from_json(bytes, path);
     }
     let twin = path.with_extension("json");
-    let spec = match yawcast_shared::blob::decode_blob(&bytes) {
+    let spec = match yawcast_shared::blob::decode_blob(bytes) {
         Ok(spec) => spec,
         Err(yawcast_shared::blob::BlobError::UnsupportedVersion(v)) if v < FORMAT_VERSION => {
             // an older blob: the JSON twin holds the same model in f64, whatever the format

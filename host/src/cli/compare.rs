@@ -1,16 +1,18 @@
 //! `yawcast compare`: fit % per record and horizon, measured vs predicted series.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
 use std::collections::BTreeMap;
+use yawcast::identify::model::Model;
 use yawcast::identify::predict::{self, Horizon};
+use yawcast::io::data::Record;
 
 use super::common::{
-    check_fit, check_horizons_fit, check_record_for_model, json_bytes, parse_horizons, read_model,
-    JsonArg, ReadArgs,
+    bad, check_fit, check_horizons_fit, check_record_for_model, parse_horizons, read_model,
+    JsonArg, Outputs, ReadArgs,
 };
 
 /// The horizons compared when `--horizons` is not given (those not shorter than a record are
@@ -66,6 +68,9 @@ pub struct CompareSummary {
 
 /// Runs `compare`.
 pub fn run(args: &CompareArgs) -> Result<()> {
+    // Where the outputs go is checked first (the series' names follow the records).
+    let series_dir = args.out.as_ref().map(|d| d.join("record.compare.csv"));
+    let mut outputs = Outputs::check(&[series_dir.as_deref(), args.json.json.as_deref()])?;
     let model = read_model(&args.model)?;
     let horizons = parse_horizons(&args.horizons)?;
     let mut records = Vec::new();
@@ -73,6 +78,25 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         let rec = args.read.read(p)?;
         check_record_for_model(&rec, &model, p)?;
         records.push(rec);
+    }
+    if args.out.is_some() {
+        // One series file per record, named after it: two records of one name would share it.
+        for (i, (r, p)) in records.iter().zip(&args.data).enumerate() {
+            if let Some(q) = records[..i]
+                .iter()
+                .zip(&args.data)
+                .find_map(|(o, q)| (o.name == r.name).then_some(q))
+            {
+                return Err(bad(format!(
+                    "{} and {}: both records are named `{}`, so their series would go to one \
+                     file {}.compare.csv under --out; rename one",
+                    q.display(),
+                    p.display(),
+                    r.name,
+                    r.name
+                )));
+            }
+        }
     }
     let horizons = if args.horizons == DEFAULT_HORIZONS {
         // The default horizons shrink to what short records can hold, with a word.
@@ -95,16 +119,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     let mut out = Vec::new();
     let mut series = Vec::new();
     for (rec, path) in records.iter().zip(&args.data) {
-        let x0 = predict::estimate_x0(&model, rec);
-        let mut fit = BTreeMap::new();
-        let mut cols = Vec::new();
-        for &h in &horizons {
-            let yhat = predict::predict(&model, rec, &x0, h);
-            let f = predict::fit(&rec.y, &yhat);
-            check_fit(f, &h.key(), path)?;
-            fit.insert(h.key(), f);
-            cols.push((h, yhat));
-        }
+        let (fit, cols) = fits(&model, rec, &horizons, path)?;
         series.push(cols);
         out.push(RecordFit {
             name: rec.name.clone(),
@@ -120,7 +135,6 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     }
     print_table(&horizons, &out, &mean_fit);
     // Every output is made in memory, then written together: all of them or none.
-    let mut files = Vec::new();
     if let Some(dir) = &args.out {
         for (rec, cols) in records.iter().zip(&series) {
             let mut s = String::from("t_s,delta_deg,r_degps");
@@ -135,29 +149,52 @@ pub fn run(args: &CompareArgs) -> Result<()> {
                 }
                 s.push('\n');
             }
-            files.push((
-                dir.join(format!("{}.compare.csv", rec.name)),
+            outputs.add(
+                &dir.join(format!("{}.compare.csv", rec.name)),
                 s.into_bytes(),
-            ));
+            );
         }
     }
-    if let Some(p) = &args.json.json {
-        files.push((
-            p.clone(),
-            json_bytes(&CompareSummary {
-                command: "compare",
-                model: args.model.display().to_string(),
-                horizons: horizons.iter().map(Horizon::key).collect(),
-                records: out,
-                mean_fit,
-            })?,
-        ));
-    }
-    yawcast::io::data::write_all_atomic(&files)?;
+    outputs.json(
+        &args.json,
+        &CompareSummary {
+            command: "compare",
+            model: args.model.display().to_string(),
+            horizons: horizons.iter().map(Horizon::key).collect(),
+            records: out,
+            mean_fit,
+        },
+    )?;
+    outputs.commit()?;
     if let Some(dir) = &args.out {
         println!("series written to {}", dir.display());
     }
     Ok(())
+}
+
+/// Predicted series per horizon.
+type Series = Vec<(Horizon, Vec<f64>)>;
+
+/// Fit % of `model` on `rec` at every horizon (x̂(0) estimated from the record), with the
+/// predicted series; a fit that is not finite or shows a diverging prediction is an error
+/// naming the record and horizon (exit 1), never a result.
+pub fn fits(
+    model: &Model,
+    rec: &Record,
+    horizons: &[Horizon],
+    path: &Path,
+) -> Result<(BTreeMap<String, f64>, Series)> {
+    let x0 = predict::estimate_x0(model, rec);
+    let mut fit = BTreeMap::new();
+    let mut cols = Vec::new();
+    for &h in horizons {
+        let yhat = predict::predict(model, rec, &x0, h);
+        let f = predict::fit(&rec.y, &yhat);
+        check_fit(f, &h.key(), path)?;
+        fit.insert(h.key(), f);
+        cols.push((h, yhat));
+    }
+    Ok((fit, cols))
 }
 
 fn print_table(horizons: &[Horizon], rows: &[RecordFit], mean: &BTreeMap<String, f64>) {

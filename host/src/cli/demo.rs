@@ -7,7 +7,7 @@ use clap::Args;
 use yawcast::demo::{self, DemoConfig};
 use yawcast::sim::Ship;
 
-use super::common::{bad, write_json, SeedArg};
+use super::common::{bad, json_bytes, Outputs, SeedArg};
 
 /// Arguments of `yawcast demo`.
 #[derive(Debug, Args)]
@@ -35,11 +35,6 @@ pub struct DemoArgs {
 
 /// Runs `yawcast demo`.
 pub fn run(args: &DemoArgs) -> Result<()> {
-    let seed = args.seed.resolve();
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("runs/demo-{seed}")));
     let ship = match &args.ship {
         Some(p) => Ship::from_file(p).map_err(bad)?,
         None => Ship::default_lng(),
@@ -57,6 +52,18 @@ pub fn run(args: &DemoArgs) -> Result<()> {
             .ok()
             .and_then(|ws| yawcast::io::hil::find_elf(&ws).ok()),
     };
+    let seed = args.seed.resolve();
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("runs/demo-{seed}")));
+    let report = out.join("report.html");
+    let summary_path = out.join("summary.json");
+    let mut outputs = Outputs::check(&[
+        Some(report.as_path()),
+        Some(summary_path.as_path()),
+        args.json.as_deref(),
+    ])?;
     let cfg = DemoConfig {
         seed,
         ship,
@@ -70,16 +77,15 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         .with_context(|| format!("creating the run directory {}", out.display()))?;
     println!("yawcast demo — {} — seed {seed}", cfg.ship.name);
     let outcome = demo::run(&cfg, &mut |line| println!("  {line}"))?;
-    let report = out.join("report.html");
-    outcome
-        .report()
-        .write(&report)
-        .with_context(|| format!("writing {}", report.display()))?;
+    // The page and the summaries appear together (the records and models the demo made on
+    // its way are written as it goes, each atomically).
+    outputs.add(&report, outcome.report().render().into_bytes());
     let summary = outcome.summary();
-    write_json(&out.join("summary.json"), &summary)?;
+    outputs.add(&summary_path, json_bytes(&summary)?);
     if let Some(j) = &args.json {
-        write_json(j, &summary)?;
+        outputs.add(j, json_bytes(&summary)?);
     }
+    outputs.commit()?;
     let f = |m: &demo::ModelResult, k: &str| m.fit.get(k).copied().unwrap_or(f64::NAN);
     println!();
     println!(

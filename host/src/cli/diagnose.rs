@@ -2,9 +2,9 @@
 //! effect on the trial records and on the reference records, a ranking and a verdict.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
 use yawcast::demo::FitSummary;
@@ -12,7 +12,7 @@ use yawcast::diagnose::{diagnose, DiagnoseConfig, Diagnosis, Ranked};
 use yawcast::identify::model::Model;
 use yawcast::io::data::Record;
 
-use super::common::{bad, check_record_for_model, read_model, JsonArg, ReadArgs, SeedArg};
+use super::common::{bad, check_record_for_model, read_model, JsonArg, Outputs, ReadArgs, SeedArg};
 
 /// Arguments of `yawcast diagnose`.
 #[derive(Debug, Args)]
@@ -88,6 +88,17 @@ fn read_checked(args: &DiagnoseArgs, paths: &[PathBuf], model: &Model) -> Result
 
 /// Runs `diagnose`.
 pub fn run(args: &DiagnoseArgs) -> Result<()> {
+    let plots = args.out.as_ref().map(|d| {
+        (
+            d.join("diagnose_evidence.svg"),
+            d.join("diagnose_before_after.svg"),
+        )
+    });
+    let mut outputs = Outputs::check(&[
+        plots.as_ref().map(|p| p.0.as_path()),
+        plots.as_ref().map(|p| p.1.as_path()),
+        args.json.json.as_deref(),
+    ])?;
     let model = read_model(&args.model)?;
     let est = read_checked(args, &args.data, &model)?;
     let reference = read_checked(args, &args.reference, &model)?;
@@ -110,29 +121,34 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
     };
     let d = diagnose(&model, &reference, &est, &val, &cfg).map_err(bad)?;
     print_report(&d);
+    if let Some((evidence, fits)) = &plots {
+        outputs.add(evidence, plot_evidence(&d, cfg.alpha)?.into_bytes());
+        outputs.add(fits, plot_fits(&d)?.into_bytes());
+    }
+    outputs.json(
+        &args.json,
+        &DiagnoseSummary {
+            command: "diagnose",
+            seed,
+            model: args.model.display().to_string(),
+            verdict: d.verdict.clone(),
+            ranking: d.ranking.clone(),
+            before: FitSummary {
+                fit: d.before.clone(),
+            },
+            after: FitSummary {
+                fit: d.after.clone(),
+            },
+            reference_used: d.reference_used,
+            explanation: d.explanation.clone(),
+            augment_explanation: d.augment.as_ref().map(|a| a.explanation.clone()),
+        },
+    )?;
+    outputs.commit()?;
     if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("creating the plot directory {}", dir.display()))?;
-        plot_evidence(&d, &dir.join("diagnose_evidence.svg"), cfg.alpha)?;
-        plot_fits(&d, &dir.join("diagnose_before_after.svg"))?;
         println!("plots written to {}", dir.display());
     }
-    args.json.write(&DiagnoseSummary {
-        command: "diagnose",
-        seed,
-        model: args.model.display().to_string(),
-        verdict: d.verdict.clone(),
-        ranking: d.ranking.clone(),
-        before: FitSummary {
-            fit: d.before.clone(),
-        },
-        after: FitSummary {
-            fit: d.after.clone(),
-        },
-        reference_used: d.reference_used,
-        explanation: d.explanation.clone(),
-        augment_explanation: d.augment.as_ref().map(|a| a.explanation.clone()),
-    })
+    Ok(())
 }
 
 fn print_report(d: &Diagnosis) {
@@ -180,7 +196,7 @@ fn plot_err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
 }
 
 /// Bar chart of −log10 p per effect, with the significance level.
-fn plot_evidence(d: &Diagnosis, path: &Path, alpha: f64) -> Result<()> {
+fn plot_evidence(d: &Diagnosis, alpha: f64) -> Result<String> {
     use plotters::prelude::*;
     let mut svg = String::new();
     {
@@ -225,12 +241,11 @@ fn plot_evidence(d: &Diagnosis, path: &Path, alpha: f64) -> Result<()> {
             .label(format!("α = {alpha}"));
         root.present().map_err(plot_err)?;
     }
-    yawcast::io::data::write_atomic(path, svg.as_bytes())?;
-    Ok(())
+    Ok(svg)
 }
 
 /// Held-out fit per horizon before and after adding the verdict's effect.
-fn plot_fits(d: &Diagnosis, path: &Path) -> Result<()> {
+fn plot_fits(d: &Diagnosis) -> Result<String> {
     use plotters::prelude::*;
     let keys = ["1", "5", "10", "20", "sim"];
     let get = |m: &BTreeMap<String, f64>, k: &str| m.get(k).copied().unwrap_or(0.0).max(-100.0);
@@ -273,6 +288,5 @@ fn plot_fits(d: &Diagnosis, path: &Path) -> Result<()> {
         }
         root.present().map_err(plot_err)?;
     }
-    yawcast::io::data::write_atomic(path, svg.as_bytes())?;
-    Ok(())
+    Ok(svg)
 }

@@ -11,7 +11,7 @@ use yawcast::io::data::Record;
 use yawcast::io::hil::{self, Device, F32Record, LiveFit, NativePredictor};
 
 use super::common::{
-    bad, check_record_for_model, progress, read_model, JsonArg, ReadArgs, SeedArg,
+    bad, check_record_for_model, progress, read_model, JsonArg, Outputs, ReadArgs, SeedArg,
 };
 
 /// Arguments of `yawcast hil`.
@@ -72,6 +72,7 @@ pub struct HilSummary {
 
 /// Runs `hil`.
 pub fn run(args: &HilArgs) -> Result<()> {
+    Outputs::check(&[args.json.json.as_deref()])?;
     if !(1..=yawcast_shared::wire::MAX_HORIZON).contains(&args.horizon) {
         return Err(bad(format!(
             "--horizon {} is outside 1..={}",

@@ -8,6 +8,8 @@ pub mod common;
 pub mod compare;
 pub mod demo;
 pub mod diagnose;
+#[cfg(test)]
+mod fuzz;
 pub mod hil;
 pub mod pipeline;
 pub mod resid;

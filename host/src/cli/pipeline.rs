@@ -10,7 +10,7 @@ use yawcast::identify::model::Model;
 use yawcast::io::data::Record;
 use yawcast::{identify::merge, identify::pem, io::export, tune::ga, tune::tables};
 
-use super::common::{bad, read_model, JsonArg, ReadArgs, SeedArg};
+use super::common::{bad, read_model, JsonArg, Outputs, ReadArgs, SeedArg};
 
 /// Reads every path of a repeatable option, naming the option when none was given.
 fn read_records(read: &ReadArgs, paths: &[PathBuf], option: &str) -> Result<Vec<Record>> {
@@ -32,10 +32,26 @@ fn names(paths: &[PathBuf]) -> String {
         .join(", ")
 }
 
-/// Exports `model` as `<out>.postcard` + `<out>.json`, checked through the firmware on `check`.
-fn write_model(model: &Model, out: &Path, check: &Record) -> Result<export::ExportReport> {
-    export::export(model, out, check)
-        .with_context(|| format!("writing the model {}", out.display()))
+/// Adds `model` as `<out>.postcard` + `<out>.json` to `outputs`, checked through the firmware
+/// on `check`.
+fn add_model(
+    outputs: &mut Outputs,
+    model: &Model,
+    out: &Path,
+    check: &Record,
+) -> Result<export::ExportReport> {
+    let (report, files) = export::prepare_with(model, out, check, &export::ExportConfig::default())
+        .with_context(|| format!("exporting the model {}", out.display()))?;
+    outputs.extend(files);
+    Ok(report)
+}
+
+/// The paths of `<out>.postcard` and `<out>.json`, when `--out` was given.
+fn model_paths(out: Option<&Path>) -> [Option<PathBuf>; 2] {
+    match out.map(export::paths) {
+        Some((b, j)) => [Some(b), Some(j)],
+        None => [None, None],
+    }
 }
 
 /// Refuses a `--json` path that is the model's own JSON twin (`--out` would be overwritten).
@@ -181,6 +197,9 @@ pub struct IdentifySummary {
 /// Runs `identify`.
 pub fn identify(args: &IdentifyArgs) -> Result<()> {
     check_json_vs_out(args.out.as_deref(), &args.json)?;
+    let [blob, twin] = model_paths(args.out.as_deref());
+    let mut outputs =
+        Outputs::check(&[blob.as_deref(), twin.as_deref(), args.json.json.as_deref()])?;
     if !(args.lambda.is_finite() && args.lambda >= 0.0) {
         return Err(bad(format!(
             "--lambda {}: expected a finite number ≥ 0",
@@ -261,10 +280,14 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
         {
             println!("lowest BIC: order {}", best.order);
         }
-        return args.json.write(&serde_json::json!({
-            "command": "identify",
-            "orders": lines,
-        }));
+        outputs.json(
+            &args.json,
+            &serde_json::json!({
+                "command": "identify",
+                "orders": lines,
+            }),
+        )?;
+        return outputs.commit();
     }
     let started = std::time::Instant::now();
     let (rep, offset) = pem::offset::identify(&recs, &cfg)
@@ -329,37 +352,46 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
         );
     }
     let mut written = None;
+    let mut done = None;
     if let Some(out) = &args.out {
         let check = val.first().unwrap_or(&recs[0]);
-        let r = write_model(&model, out, check)?;
-        println!(
+        let r = add_model(&mut outputs, &model, out, check)?;
+        done = Some(format!(
             "model written to {} and {}",
             r.blob_path.display(),
             r.json_path.display()
-        );
+        ));
         written = Some(r.blob_path.display().to_string());
     }
-    args.json.write(&IdentifySummary {
-        command: "identify",
-        order: rep.model.n,
-        lambda: rep.lambda,
-        names: rep.names.clone(),
-        values: all_params(&model),
-        std_pct: rep.std_pct.clone(),
-        reliability: rep.reliability,
-        aic: rep.aic,
-        bic: rep.bic,
-        iterations: rep.iterations,
-        fit_identification: rep.fit.clone(),
-        fit,
-        model: written,
-        identify_s,
-        focus: horizons.last().copied(),
-        focus_horizons: horizons,
-        start: rep.start,
-        start_choice: rep.choice.clone(),
-        offset,
-    })
+    outputs.json(
+        &args.json,
+        &IdentifySummary {
+            command: "identify",
+            order: rep.model.n,
+            lambda: rep.lambda,
+            names: rep.names.clone(),
+            values: all_params(&model),
+            std_pct: rep.std_pct.clone(),
+            reliability: rep.reliability,
+            aic: rep.aic,
+            bic: rep.bic,
+            iterations: rep.iterations,
+            fit_identification: rep.fit.clone(),
+            fit,
+            model: written,
+            identify_s,
+            focus: horizons.last().copied(),
+            focus_horizons: horizons,
+            start: rep.start,
+            start_choice: rep.choice.clone(),
+            offset,
+        },
+    )?;
+    outputs.commit()?;
+    if let Some(d) = done {
+        println!("{d}");
+    }
+    Ok(())
 }
 
 /// Identification errors caused by the data are bad input; a search that found no stable
@@ -438,6 +470,21 @@ pub struct TuneArgs {
 /// Runs `tune`.
 pub fn tune(args: &TuneArgs) -> Result<()> {
     check_json_vs_out(args.out.as_deref(), &args.json)?;
+    let [blob, twin] = model_paths(args.out.as_deref());
+    let (md, tj) = match args.out.as_deref().map(tables::Tables::paths) {
+        Some((m, t)) => (Some(m), Some(t)),
+        None => (None, None),
+    };
+    let mut outputs = Outputs::check(&[
+        blob.as_deref(),
+        twin.as_deref(),
+        md.as_deref(),
+        tj.as_deref(),
+        args.json.json.as_deref(),
+    ])?;
+    if args.generations == 0 {
+        return Err(bad("--generations 0: at least one generation is needed"));
+    }
     let sim = read_records(&args.read, &args.data, "--data")?;
     let trials = read_records(&args.read, &args.validate, "--validate")?;
     let horizons: Vec<usize> = args
@@ -553,23 +600,29 @@ pub fn tune(args: &TuneArgs) -> Result<()> {
     if let Some(t) = &tables {
         println!("{}", t.to_markdown());
     }
+    let mut done = Vec::new();
     if let Some(out) = &args.out {
-        let r = write_model(&rep.best_model, out, &trials[0])?;
+        let r = add_model(&mut outputs, &rep.best_model, out, &trials[0])?;
         let which = match &rep.gain {
             Some(g) if !g.tuned_kept => "conventional",
             _ => "tuned",
         };
-        println!(
+        done.push(format!(
             "{which} model written to {} and {}",
             r.blob_path.display(),
             r.json_path.display()
-        );
+        ));
         if let Some(t) = &tables {
-            let (md, js) = t.write(out)?;
-            println!("tables written to {} and {}", md.display(), js.display());
+            outputs.extend(t.files(out));
+            let (md, js) = tables::Tables::paths(out);
+            done.push(format!(
+                "tables written to {} and {}",
+                md.display(),
+                js.display()
+            ));
         }
     }
-    args.json.write(&serde_json::json!({
+    outputs.json(&args.json, &serde_json::json!({
         "command": "tune",
         "seed": rep.seed,
         "lambda": rep.lambda,
@@ -582,7 +635,12 @@ pub fn tune(args: &TuneArgs) -> Result<()> {
         "conventional": rep.conventional.as_ref().map(|c| serde_json::json!({ "fit": c.fits, "std_pct": c.std_pct })),
         "history": rep.history,
         "gain": rep.gain,
-    }))
+    }))?;
+    outputs.commit()?;
+    for d in done {
+        println!("{d}");
+    }
+    Ok(())
 }
 
 /// Which combination `average` writes.
@@ -625,6 +683,9 @@ pub struct AverageArgs {
 /// Runs `average`.
 pub fn average(args: &AverageArgs) -> Result<()> {
     check_json_vs_out(args.out.as_deref(), &args.json)?;
+    let [blob, twin] = model_paths(args.out.as_deref());
+    let mut outputs =
+        Outputs::check(&[blob.as_deref(), twin.as_deref(), args.json.json.as_deref()])?;
     let recs = read_records(&args.read, &args.data, "--data")?;
     let val = read_records(&args.read, &args.validate, "--validate")?;
     let cfg = pem::PemConfig {
@@ -668,6 +729,7 @@ pub fn average(args: &AverageArgs) -> Result<()> {
     if let Some(c) = chosen {
         println!("chosen: {}", c.name);
     }
+    let mut done = None;
     if let Some(out) = &args.out {
         let c = chosen.ok_or_else(|| {
             anyhow::anyhow!(
@@ -675,22 +737,30 @@ pub fn average(args: &AverageArgs) -> Result<()> {
                 args.method
             )
         })?;
-        let r = write_model(&c.model, out, &val[0])?;
-        println!(
+        let r = add_model(&mut outputs, &c.model, out, &val[0])?;
+        done = Some(format!(
             "model written to {} and {}",
             r.blob_path.display(),
             r.json_path.display()
-        );
+        ));
     }
-    args.json.write(&serde_json::json!({
-        "command": "average",
-        "best": rep.best,
-        "chosen": chosen.map(|c| c.name.clone()),
-        "combinations": rep.combinations.iter().map(|c| serde_json::json!({
-            "name": c.name, "fit": c.fits, "stable": c.stable, "note": c.note,
-        })).collect::<Vec<_>>(),
-        "merge_error": rep.merge_error,
-    }))
+    outputs.json(
+        &args.json,
+        &serde_json::json!({
+            "command": "average",
+            "best": rep.best,
+            "chosen": chosen.map(|c| c.name.clone()),
+            "combinations": rep.combinations.iter().map(|c| serde_json::json!({
+                "name": c.name, "fit": c.fits, "stable": c.stable, "note": c.note,
+            })).collect::<Vec<_>>(),
+            "merge_error": rep.merge_error,
+        }),
+    )?;
+    outputs.commit()?;
+    if let Some(d) = done {
+        println!("{d}");
+    }
+    Ok(())
 }
 
 /// Arguments of `yawcast export`.
@@ -717,6 +787,13 @@ pub struct ExportArgs {
 /// Runs `export`.
 pub fn export_cmd(args: &ExportArgs) -> Result<()> {
     check_json_vs_out(Some(&args.out), &args.json)?;
+    let [blob, twin] = model_paths(Some(&args.out));
+    let mut outputs = Outputs::check(&[
+        blob.as_deref(),
+        twin.as_deref(),
+        args.golden.as_deref(),
+        args.json.json.as_deref(),
+    ])?;
     let model = read_model(&args.model)?;
     let check = args.read.read(&args.data)?;
     super::common::check_record_for_model(&check, &model, &args.data)?;
@@ -724,10 +801,14 @@ pub fn export_cmd(args: &ExportArgs) -> Result<()> {
         golden: args.golden.clone(),
         ..export::ExportConfig::default()
     };
-    let r = export::export_with(&model, &args.out, &check, &cfg).map_err(|e| match e {
-        export::ExportError::Check { .. } | export::ExportError::Model(_) => bad(e),
-        other => anyhow::Error::new(other),
-    })?;
+    let (r, files) =
+        export::prepare_with(&model, &args.out, &check, &cfg).map_err(|e| match e {
+            export::ExportError::Check { .. } | export::ExportError::Model(_) => bad(e),
+            other => anyhow::Error::new(other),
+        })?;
+    outputs.extend(files);
+    outputs.json(&args.json, &r)?;
+    outputs.commit()?;
     println!(
         "{:>8} {:>12} {:>14} {:>10}",
         "horizon", "host f64", "firmware f32", "Δ [pp]"
@@ -751,5 +832,5 @@ pub fn export_cmd(args: &ExportArgs) -> Result<()> {
             .map(|g| format!("; golden vectors {}", g.display()))
             .unwrap_or_default()
     );
-    args.json.write(&r)
+    Ok(())
 }

@@ -5,13 +5,12 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use yawcast::diagnose::resid::{resid, Correlation, ResidConfig, ResidReport};
-use yawcast::io::data::write_all_atomic;
 use yawcast::io::report::svg::stem_chart;
 
-use super::common::{bad, check_record_for_model, json_bytes, read_model, JsonArg, ReadArgs};
+use super::common::{bad, check_record_for_model, read_model, JsonArg, Outputs, ReadArgs};
 
 /// Arguments of `yawcast resid`.
 #[derive(Debug, Args)]
@@ -42,6 +41,11 @@ pub fn run(args: &ResidArgs) -> Result<()> {
     if args.max_lag == 0 || args.horizon == 0 {
         return Err(bad("--max-lag and --horizon must be at least 1"));
     }
+    let (acf, ccf) = match &args.out {
+        Some(d) => (Some(d.join("acf.svg")), Some(d.join("ccf.svg"))),
+        None => (None, None),
+    };
+    let mut outputs = Outputs::check(&[acf.as_deref(), ccf.as_deref(), args.json.json.as_deref()])?;
     let model = read_model(&args.model)?;
     let mut records = Vec::new();
     for p in &args.data {
@@ -74,25 +78,22 @@ pub fn run(args: &ResidArgs) -> Result<()> {
     }
     print_report(&rep);
     // Every output is made in memory first, then written together: all or none.
-    let mut files = Vec::new();
-    if let Some(dir) = &args.out {
+    if let (Some(acf), Some(ccf)) = (&acf, &ccf) {
         let stem = |c: &Correlation, title: &str| {
             let lags: Vec<f64> = c.lags.iter().map(|&l| l as f64).collect();
             stem_chart(title, "lag (samples)", &lags, &c.values, &[c.band]).into_bytes()
         };
-        files.push((
-            dir.join("acf.svg"),
+        outputs.add(
+            acf,
             stem(&rep.acf, "autocorrelation of the one-step residuals"),
-        ));
-        files.push((
-            dir.join("ccf.svg"),
+        );
+        outputs.add(
+            ccf,
             stem(&rep.ccf, "cross-correlation of residuals and input"),
-        ));
+        );
     }
-    if let Some(p) = &args.json.json {
-        files.push((p.clone(), json_bytes(&rep)?));
-    }
-    write_all_atomic(&files).context("writing the outputs")?;
+    outputs.json(&args.json, &rep)?;
+    outputs.commit()?;
     if let Some(dir) = &args.out {
         println!("plots written to {}", dir.display());
     }

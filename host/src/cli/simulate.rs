@@ -3,13 +3,13 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
 use yawcast::sim::{self, InputSpec, NoiseSpec, Scenario, Ship, SimEffect};
 use yawcast_shared::model::EffectKind;
 
-use super::common::{bad, JsonArg, SeedArg};
+use super::common::{bad, JsonArg, Outputs, SeedArg};
 
 /// Arguments of `yawcast simulate`.
 #[derive(Debug, Args)]
@@ -140,6 +140,15 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             return Err(bad(format!("{flag} {v}: expected a finite number ≥ 0")));
         }
     }
+    let records: Vec<PathBuf> = match &args.out {
+        Some(out) => (1..=args.records)
+            .map(|i| numbered(out, i, args.records))
+            .collect(),
+        None => Vec::new(),
+    };
+    let mut wanted: Vec<Option<&Path>> = records.iter().map(|p| Some(p.as_path())).collect();
+    wanted.extend([args.save_ship.as_deref(), args.json.json.as_deref()]);
+    let mut outputs = Outputs::check(&wanted)?;
     let ship = match &args.ship {
         Some(p) => Ship::from_file(p).map_err(bad)?,
         None => Ship::default_lng(),
@@ -191,19 +200,18 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     scenario.validate().map_err(bad)?;
     let seed = args.seed.resolve();
     let mut written = Vec::new();
-    if let Some(out) = &args.out {
+    let mut done = Vec::new();
+    if args.out.is_some() {
         let seeds: Vec<u64> = (0..args.records as u64).map(|i| seed + i).collect();
         let recs = sim::simulate_many(&ship, &scenario, &seeds).map_err(bad)?;
-        for (i, (rec, s)) in recs.iter().zip(&seeds).enumerate() {
-            let path = numbered(out, i + 1, args.records);
-            yawcast::io::data::write_csv(&path, rec)
-                .with_context(|| format!("writing {}", path.display()))?;
-            println!(
+        for ((rec, s), path) in recs.iter().zip(&seeds).zip(&records) {
+            outputs.add(path, yawcast::io::data::csv_text(rec).into_bytes());
+            done.push(format!(
                 "{}: {} samples at Ts = {} s, seed {s}",
                 path.display(),
                 rec.len(),
                 rec.ts
-            );
+            ));
             written.push(Written {
                 path: path.display().to_string(),
                 seed: *s,
@@ -218,19 +226,26 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     }
     if let Some(p) = &args.save_ship {
         let text = ship_out.to_toml_string().map_err(bad)?;
-        yawcast::io::data::write_atomic(p, text.as_bytes())
-            .with_context(|| format!("writing the ship file {}", p.display()))?;
-        println!("{}: ship file ({})", p.display(), ship_out.name);
+        outputs.add(p, text.into_bytes());
+        done.push(format!("{}: ship file ({})", p.display(), ship_out.name));
     }
     if !effects.is_empty() {
         let names: Vec<&str> = effects.iter().map(|e| e.kind().name()).collect();
-        println!("effects on: {}", names.join(", "));
+        done.push(format!("effects on: {}", names.join(", ")));
     }
-    args.json.write(&Summary {
-        command: "simulate",
-        seed,
-        ship: ship.name.clone(),
-        effects,
-        records: written,
-    })
+    outputs.json(
+        &args.json,
+        &Summary {
+            command: "simulate",
+            seed,
+            ship: ship.name.clone(),
+            effects,
+            records: written,
+        },
+    )?;
+    outputs.commit()?;
+    for d in done {
+        println!("{d}");
+    }
+    Ok(())
 }

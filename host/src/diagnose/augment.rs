@@ -1077,6 +1077,9 @@ pub struct Tried {
     pub fit_gain_pp: f64,
     /// ΔBIC against the round's model re-identified.
     pub delta_bic: f64,
+    /// Why it has no fit (the effect could not be identified, its fits are NaN): the
+    /// refusal in words; `None` when it was identified.
+    pub note: Option<String>,
 }
 
 /// One round of [`forward`]: every library effect the model lacks, tried on it.
@@ -1195,6 +1198,7 @@ pub fn forward(
                 fit_10: r.after.get("10").copied().unwrap_or(f64::NAN),
                 fit_gain_pp: r.fit_gain_pp,
                 delta_bic: r.delta_bic,
+                note: (!r.fit_gain_pp.is_finite()).then(|| r.explanation.clone()),
             })
             .collect();
         let best = reports

@@ -2061,7 +2061,24 @@ mod tests {
         let mut bad_order = m.clone();
         bad_order.n = 3;
         let e = diagnose(&bad_order, &[], &f, &[], &cfg).unwrap_err();
-        assert!(e.to_string().contains("3"), "{e}");
+        // The model itself is refused, naming the vector, its length and the order claimed.
+        assert!(
+            matches!(
+                &e,
+                DiagnoseError::Input(InputError::Model(
+                    crate::identify::model::ModelError::Length {
+                        name: "a",
+                        found: 4,
+                        order: 3
+                    }
+                ))
+            ),
+            "{e:?}"
+        );
+        assert_eq!(
+            e.to_string(),
+            "the model is invalid: parameter vector `a` has 4 values, the order is 3"
+        );
         let e = diagnose(
             &m,
             &[],

@@ -266,21 +266,53 @@ pub fn export(model: &Model, out: &Path, check: &Record) -> Result<ExportReport,
 }
 
 /// Checks `model` through the firmware on `check`, then writes `<out>.postcard`, `<out>.json`
-/// and, when asked, the golden vectors — each atomically.
+/// and, when asked, the golden vectors — all together or none ([`data::write_all_atomic`]).
 ///
 /// # Errors
 /// [`ExportError::Model`] for an invalid model or one the f32 schema refuses (unstable after
 /// rounding, out of range); [`ExportError::Check`] for a check record that is too short or
 /// not finite; [`ExportError::Firmware`] when the firmware library refuses the model or its
 /// prediction goes non-finite; [`ExportError::Mismatch`] when host and firmware fits differ
-/// by more than the tolerance; [`ExportError::Io`] when a file cannot be written (files
-/// already written by this call are then removed).
+/// by more than the tolerance; [`ExportError::Io`] when a file cannot be written (then none
+/// is, and files it would have replaced keep their content).
 pub fn export_with(
     model: &Model,
     out: &Path,
     check: &Record,
     cfg: &ExportConfig,
 ) -> Result<ExportReport, ExportError> {
+    let (report, files) = prepare_with(model, out, check, cfg)?;
+    data::write_all_atomic(&files)?;
+    Ok(report)
+}
+
+/// Everything [`export_with`] does but the writing: the checks through the firmware, the
+/// report, and the files (`<out>.json`, the golden vectors when asked, `<out>.postcard`) with
+/// their bytes, for a caller that writes them together with its other outputs.
+///
+/// # Errors
+/// As [`export_with`], without [`ExportError::Io`].
+///
+/// ```
+/// use yawcast::{identify::model::Model, identify::predict, io::data::Record};
+/// use yawcast::io::export::{prepare_with, ExportConfig};
+/// let m = Model::new(1.0, vec![-0.3, 0.9], vec![0.5, 0.4], vec![0.2, 0.1]).unwrap();
+/// let u: Vec<f64> = (0..300).map(|i| if (i * 37 / 11) % 2 == 0 { 1.0 } else { -1.0 }).collect();
+/// let mut check = Record::from_uy("check", 1.0, u, vec![0.0; 300]);
+/// check.y = predict::simulate(&m, &check, &[0.0, 0.0]);
+/// let out = std::path::Path::new("never/written/ship");
+/// let (rep, files) = prepare_with(&m, out, &check, &ExportConfig::default()).unwrap();
+/// assert_eq!(files.len(), 2);
+/// assert_eq!(files[1].0, rep.blob_path);
+/// assert_eq!(files[1].1.len(), rep.blob_len);
+/// assert!(!out.parent().unwrap().exists());
+/// ```
+pub fn prepare_with(
+    model: &Model,
+    out: &Path,
+    check: &Record,
+    cfg: &ExportConfig,
+) -> Result<(ExportReport, data::OutputFiles), ExportError> {
     model
         .validate()
         .map_err(|e| ExportError::Model(e.to_string()))?;
@@ -391,34 +423,23 @@ pub fn export_with(
         None => None,
     };
     let (blob_path, json_path) = paths(out);
-    let mut written: Vec<PathBuf> = Vec::new();
-    let mut write = |path: &Path, bytes: &[u8]| -> Result<(), ExportError> {
-        match data::write_atomic(path, bytes) {
-            Ok(()) => {
-                written.push(path.to_path_buf());
-                Ok(())
-            }
-            Err(e) => {
-                for w in &written {
-                    let _ = std::fs::remove_file(w);
-                }
-                Err(e.into())
-            }
-        }
-    };
-    write(&json_path, json_text.as_bytes())?;
-    if let Some((p, text)) = &golden {
-        write(p, text.as_bytes())?;
-    }
-    write(&blob_path, &blob_bytes)?;
-    Ok(ExportReport {
-        blob_path,
-        json_path,
-        golden_path: golden.map(|g| g.0),
-        blob_len: blob_bytes.len(),
-        checks,
-        x0,
-    })
+    let mut files = vec![(json_path.clone(), json_text.into_bytes())];
+    let golden_path = golden.map(|(p, text)| {
+        files.push((p.clone(), text.into_bytes()));
+        p
+    });
+    files.push((blob_path.clone(), blob_bytes.clone()));
+    Ok((
+        ExportReport {
+            blob_path,
+            json_path,
+            golden_path,
+            blob_len: blob_bytes.len(),
+            checks,
+            x0,
+        },
+        files,
+    ))
 }
 
 #[cfg(test)]

@@ -216,8 +216,20 @@ pub fn native_run(spec: &ModelSpec, rec: &F32Record, h: usize) -> Result<Vec<Vec
 
 /// Where the firmware ELF may be: `$YAWCAST_FW_ELF`, then the usual build directories.
 pub fn elf_candidates(workspace: &Path) -> Vec<PathBuf> {
+    elf_candidates_with(std::env::var_os(ELF_VAR).as_deref(), workspace)
+}
+
+/// [`elf_candidates`] with the value of [`ELF_VAR`] given (`None`: not set).
+///
+/// ```
+/// use std::{ffi::OsStr, path::Path};
+/// let c = yawcast::io::hil::elf_candidates_with(Some(OsStr::new("/fw.elf")), Path::new("/ws"));
+/// assert_eq!(c[0], Path::new("/fw.elf"));
+/// assert_eq!(c[1], Path::new("/ws/target/thumbv7em-none-eabihf/release/yawcast-fw"));
+/// ```
+pub fn elf_candidates_with(var: Option<&std::ffi::OsStr>, workspace: &Path) -> Vec<PathBuf> {
     let mut v = Vec::new();
-    if let Some(p) = std::env::var_os(ELF_VAR) {
+    if let Some(p) = var {
         v.push(PathBuf::from(p));
     }
     for sub in ["target", "target/thumb"] {
@@ -237,7 +249,11 @@ pub fn elf_candidates(workspace: &Path) -> Vec<PathBuf> {
 /// # Errors
 /// [`HilError::NoElf`] naming the places looked at.
 pub fn find_elf(workspace: &Path) -> Result<PathBuf, HilError> {
-    let c = elf_candidates(workspace);
+    first_elf(&elf_candidates(workspace))
+}
+
+/// The first of `c` that is a file, or [`HilError::NoElf`] naming them all.
+fn first_elf(c: &[PathBuf]) -> Result<PathBuf, HilError> {
     c.iter()
         .find(|p| p.is_file())
         .cloned()
@@ -737,15 +753,39 @@ mod tests {
 
     #[test]
     fn missing_elf_names_where_it_looked() {
-        if std::env::var_os(ELF_VAR).is_some() {
-            return;
-        }
-        let e = find_elf(Path::new("/nonexistent-ws"))
-            .unwrap_err()
-            .to_string();
+        // Whatever the environment: an ELF named by the variable but absent, and none built.
+        let c = elf_candidates_with(
+            Some(std::ffi::OsStr::new("/nonexistent-fw.elf")),
+            Path::new("/nonexistent-ws"),
+        );
+        let e = first_elf(&c).unwrap_err().to_string();
         assert!(
-            e.contains("/nonexistent-ws/target") && e.contains("fw-build"),
+            e.contains(
+                "/nonexistent-fw.elf, /nonexistent-ws/target/thumbv7em-none-eabihf/release/yawcast-fw, \
+                 /nonexistent-ws/target/thumb/thumbv7em-none-eabihf/release/yawcast-fw"
+            ) && e.contains("fw-build"),
             "{e}"
         );
+        match std::env::var_os(ELF_VAR) {
+            // Without the variable, the build directories are where it looks.
+            None => {
+                let e = find_elf(Path::new("/nonexistent-ws"))
+                    .unwrap_err()
+                    .to_string();
+                assert!(e.contains("/nonexistent-ws/target"), "{e}");
+            }
+            // With it (as in CI), the ELF it names must be there and be the one found.
+            Some(v) => {
+                assert!(
+                    Path::new(&v).is_file(),
+                    "{ELF_VAR}={} names no file: build the firmware first",
+                    Path::new(&v).display()
+                );
+                assert_eq!(
+                    find_elf(Path::new("/nonexistent-ws")).unwrap(),
+                    PathBuf::from(v)
+                );
+            }
+        }
     }
 }

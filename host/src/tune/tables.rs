@@ -387,23 +387,60 @@ impl Tables {
         s
     }
 
-    /// Writes `<out>.tables.md` and `<out>.tables.json` (a `.postcard`/`.json` extension on
-    /// `out` is dropped first), each atomically; returns their paths.
+    /// `<out>.tables.md` and `<out>.tables.json` (a `.postcard`/`.json` extension on `out` is
+    /// dropped first).
     ///
-    /// # Errors
-    /// [`data::DataError::Io`] when a file cannot be written (the other is then removed).
-    pub fn write(&self, out: &Path) -> Result<(PathBuf, PathBuf), data::DataError> {
+    /// ```
+    /// use std::path::Path;
+    /// let (md, js) = yawcast::tune::tables::Tables::paths(Path::new("runs/ship.postcard"));
+    /// assert_eq!(md, Path::new("runs/ship.tables.md"));
+    /// assert_eq!(js, Path::new("runs/ship.tables.json"));
+    /// ```
+    pub fn paths(out: &Path) -> (PathBuf, PathBuf) {
         let (blob, _) = crate::io::export::paths(out);
         let stem = blob.with_extension("");
-        let md = PathBuf::from(format!("{}.tables.md", stem.display()));
-        let js = PathBuf::from(format!("{}.tables.json", stem.display()));
+        (
+            PathBuf::from(format!("{}.tables.md", stem.display())),
+            PathBuf::from(format!("{}.tables.json", stem.display())),
+        )
+    }
+
+    /// The two files of [`Tables::write`] with their bytes, for a caller that writes them
+    /// together with its other outputs.
+    ///
+    /// ```
+    /// use std::path::Path;
+    /// use yawcast::{io::data::Record, identify::model::Model, identify::predict, tune::tables::{Column, Tables}};
+    /// let m = Model::new(1.0, vec![0.0, 0.5], vec![1.0, 0.5], vec![0.1, 0.0]).unwrap();
+    /// let u: Vec<f64> = (0..200).map(|i| if i % 9 < 4 { 1.0 } else { -1.0 }).collect();
+    /// let mut r = Record::from_uy("lake", 1.0, u, vec![0.0; 200]);
+    /// r.y = predict::simulate(&m, &r, &[0.0, 0.0]);
+    /// let col = |label: &str| Column { label: label.into(), model: m.clone(), std: vec![0.01; 6], r: None, lambda: None };
+    /// let t = Tables::compare(&col("conventional"), &col("GA-tuned"), &[r]).unwrap();
+    /// let files = t.files(Path::new("runs/ship"));
+    /// assert_eq!(files[0].0, Path::new("runs/ship.tables.md"));
+    /// assert_eq!(files[0].1, t.to_markdown().into_bytes());
+    /// assert_eq!(files[1].0, Path::new("runs/ship.tables.json"));
+    /// let v: serde_json::Value = serde_json::from_slice(&files[1].1).unwrap();
+    /// assert_eq!(v["trial_records"], 1);
+    /// ```
+    pub fn files(&self, out: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+        let (md, js) = Self::paths(out);
         let json = serde_json::to_string_pretty(self).unwrap_or_else(|_| "{}".into());
-        data::write_atomic(&md, self.to_markdown().as_bytes())?;
-        if let Err(e) = data::write_atomic(&js, json.as_bytes()) {
-            let _ = std::fs::remove_file(&md);
-            return Err(e);
-        }
-        Ok((md, js))
+        vec![
+            (md, self.to_markdown().into_bytes()),
+            (js, json.into_bytes()),
+        ]
+    }
+
+    /// Writes `<out>.tables.md` and `<out>.tables.json` ([`Tables::paths`]) together or not
+    /// at all; returns their paths.
+    ///
+    /// # Errors
+    /// [`data::DataError::Io`] when a file cannot be written (then neither is).
+    pub fn write(&self, out: &Path) -> Result<(PathBuf, PathBuf), data::DataError> {
+        data::write_all_atomic(&self.files(out))?;
+        Ok(Self::paths(out))
     }
 }
 
