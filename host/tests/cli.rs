@@ -1068,7 +1068,7 @@ fn augment_adds_a_dead_time_exports_it_and_writes_the_ship() {
         stdout(&o)
     );
     assert!(
-        stdout(&o).contains("a dead time of 2.0 s"),
+        stdout(&o).contains("now carries a command dead time of 2.0 s"),
         "{}",
         stdout(&o)
     );
