@@ -1,0 +1,292 @@
+//! Measured records: free-running zig-zags of the 3.0 m Esso Osaka model (Osaka University's
+//! Inukai pond, FRT-DS-ESSO, CC BY-NC-SA 4.0; `tests/data/real/esso_osaka/PROVENANCE.md`),
+//! run through the CLI: identify → compare on held-out records → diagnose → augment.
+//!
+//! The reference is the rig itself: the model is identified on the ±15° and one ±20° zig-zag
+//! and the trials are the other ±20° and the ±30° zig-zag of the same day, hull, propeller
+//! revolutions (12 rps) and sampling (0.4 s). No simulator of this hull exists in yawcast yet
+//! (the built-in one is a 1:24 LNG carrier with pods), so `diagnose` is asked the question it
+//! can answer honestly here: what do the larger zig-zags show that the smaller ones lack?
+//!
+//! The floors below are the figures the pipeline gave on these records, less a margin; the
+//! diagnosis is run under three seeds and only what held under five (1–5) is asserted.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn data(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/data/real/esso_osaka")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("yawcast-real-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn run(args: &[&str]) -> Output {
+    let o = Command::new(env!("CARGO_BIN_EXE_yawcast"))
+        .args(args)
+        .output()
+        .expect("runs the binary");
+    assert!(
+        o.status.success(),
+        "yawcast {}\nstdout:\n{}\nstderr:\n{}",
+        args.join(" "),
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
+fn json(p: &Path) -> Value {
+    serde_json::from_slice(&std::fs::read(p).unwrap()).unwrap()
+}
+
+fn fit(v: &Value, horizon: &str) -> f64 {
+    v[horizon]
+        .as_f64()
+        .unwrap_or_else(|| panic!("no fit at {horizon}: {v}"))
+}
+
+const REFERENCE: [&str; 2] = ["zz15_n12.csv", "zz20_n12_a.csv"];
+const TRIALS: [&str; 2] = ["zz30_n12.csv", "zz20_n12_b.csv"];
+
+/// Rows of a converted record: (t, δ, r).
+fn rows(name: &str) -> Vec<(f64, f64, f64)> {
+    let text = std::fs::read_to_string(data(name)).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "t_s,delta_deg,r_degps,psi_deg,u_mps,wind_speed_mps,wind_angle_deg"
+    );
+    lines
+        .map(|l| {
+            let c: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            (c[0], c[1], c[2])
+        })
+        .collect()
+}
+
+/// The records are what the source documents: its zig-zag amplitudes (in degrees, so the
+/// units were converted), uniform 0.4 s sampling, and a positive rudder angle turning the
+/// ship to starboard, yawcast's convention.
+#[test]
+fn records_match_the_documented_zigzags() {
+    for (name, amplitude) in [
+        ("zz15_n12.csv", 15.0),
+        ("zz20_n12_a.csv", 20.0),
+        ("zz20_n12_b.csv", 20.0),
+        ("zz30_n12.csv", 30.0),
+    ] {
+        let r = rows(name);
+        assert!(r.len() >= 200, "{name}: {} rows", r.len());
+        for (k, &(t, _, _)) in r.iter().enumerate() {
+            assert!(
+                (t - 0.4 * k as f64).abs() < 1e-6,
+                "{name}: t = {t} at row {k}"
+            );
+        }
+        let mut held: Vec<f64> = r
+            .iter()
+            .map(|&(_, d, _)| d.abs())
+            .filter(|&d| d >= 0.5 * amplitude)
+            .collect();
+        held.sort_by(f64::total_cmp);
+        let median = held[held.len() / 2];
+        assert!(
+            (median - amplitude).abs() < 1.0,
+            "{name}: zig-zag rudder {median:.2}°, documented ±{amplitude}°"
+        );
+        let (mut c, mut n) = (0.0, 0.0);
+        for &(_, d, y) in &r {
+            c += d * y;
+            n += d * d;
+        }
+        assert!(c / n > 0.0, "{name}: rudder and yaw rate of opposite signs");
+    }
+}
+
+#[test]
+fn identify_compare_diagnose_augment_on_measured_zigzags() {
+    let dir = scratch("pipeline");
+    let model = dir.join("ref");
+    let model_blob = dir.join("ref.postcard");
+    let mut args: Vec<String> = vec!["identify".into()];
+    for r in REFERENCE {
+        args.extend(["--data".into(), data(r)]);
+    }
+    for t in TRIALS {
+        args.extend(["--validate".into(), data(t)]);
+    }
+    args.extend([
+        "--out".into(),
+        model.to_string_lossy().into_owned(),
+        "--json".into(),
+        dir.join("identify.json").to_string_lossy().into_owned(),
+    ]);
+    run(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    let id = json(&dir.join("identify.json"));
+    assert_eq!(id["order"], 4);
+
+    // Held-out records, per record. Measured: 1 step 99.95 / 99.97 %, 5 steps 96.84 / 97.80 %,
+    // 10 steps 81.12 / 83.80 % (zz20_n12_b / zz30_n12); mean 10 steps 82.46 %.
+    let cmp_json = dir.join("compare.json");
+    let mut args: Vec<String> = vec![
+        "compare".into(),
+        "--model".into(),
+        model_blob.to_string_lossy().into_owned(),
+    ];
+    for t in TRIALS {
+        args.extend(["--data".into(), data(t)]);
+    }
+    args.extend(["--json".into(), cmp_json.to_string_lossy().into_owned()]);
+    run(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    let cmp = json(&cmp_json);
+    for rec in cmp["records"].as_array().unwrap() {
+        let name = rec["name"].as_str().unwrap();
+        assert!(fit(&rec["fit"], "1") > 99.0, "{name}: {}", rec["fit"]);
+        assert!(fit(&rec["fit"], "5") > 93.0, "{name}: {}", rec["fit"]);
+        assert!(fit(&rec["fit"], "10") > 75.0, "{name}: {}", rec["fit"]);
+    }
+    assert!(fit(&cmp["mean_fit"], "10") > 78.0, "{}", cmp["mean_fit"]);
+
+    // The trials against the reference records, three seeds.
+    for seed in ["1", "2", "3"] {
+        let diag_json = dir.join(format!("diagnose-{seed}.json"));
+        let mut args: Vec<String> = vec![
+            "diagnose".into(),
+            "--model".into(),
+            model_blob.to_string_lossy().into_owned(),
+        ];
+        for r in REFERENCE {
+            args.extend(["--reference".into(), data(r)]);
+        }
+        for t in TRIALS {
+            args.extend(["--data".into(), data(t)]);
+        }
+        args.extend([
+            "--seed".into(),
+            seed.into(),
+            "--json".into(),
+            diag_json.to_string_lossy().into_owned(),
+        ]);
+        run(&args.iter().map(String::as_str).collect::<Vec<_>>());
+        let d = json(&diag_json);
+        let verdict = d["verdict"].as_str().unwrap().to_string();
+        let ranking = d["ranking"].as_array().unwrap();
+        let named: Vec<&str> = ranking
+            .iter()
+            .filter(|r| r["significant"] == true && r["material"] == true)
+            .map(|r| r["effect"].as_str().unwrap())
+            .collect();
+        // The verdict agrees with the table printed beside it.
+        if verdict == "none" {
+            assert!(named.is_empty(), "seed {seed}: verdict none but {named:?}");
+        } else {
+            assert!(
+                named.contains(&verdict.as_str()),
+                "seed {seed}: verdict {verdict} not significant and material in {named:?}"
+            );
+        }
+        // Measured under seeds 1–5: `none` (1, 5) or `asymmetry` (2–4); the asymmetry's
+        // bootstrap p straddles α = 0.01 (starboard rudder 38 % less effective on the
+        // trials, which a single-screw hull can show; its held-out gain is +0.03 pp).
+        assert!(
+            verdict == "none" || verdict == "asymmetry",
+            "seed {seed}: verdict {verdict}: {}",
+            d["explanation"]
+        );
+        // Held-out fit of the reference model on the trials' last part. Measured: 83.40 %.
+        assert!(
+            fit(&d["before"]["fit"], "10") > 78.0,
+            "{}",
+            d["before"]["fit"]
+        );
+
+        // augment --effect auto runs the same diagnosis and follows it.
+        let out = dir.join(format!("aug-{seed}"));
+        let aug_json = dir.join(format!("augment-{seed}-report.json"));
+        let mut args: Vec<String> = vec![
+            "augment".into(),
+            "--model".into(),
+            model_blob.to_string_lossy().into_owned(),
+            "--effect".into(),
+            "auto".into(),
+        ];
+        for r in REFERENCE {
+            args.extend(["--reference".into(), data(r)]);
+        }
+        for t in TRIALS {
+            args.extend(["--data".into(), data(t)]);
+        }
+        args.extend([
+            "--seed".into(),
+            seed.into(),
+            "--out".into(),
+            out.to_string_lossy().into_owned(),
+            "--json".into(),
+            aug_json.to_string_lossy().into_owned(),
+        ]);
+        run(&args.iter().map(String::as_str).collect::<Vec<_>>());
+        let a = json(&aug_json);
+        assert_eq!(a["effect"].as_str().unwrap(), verdict, "seed {seed}");
+        assert!(dir.join(format!("aug-{seed}.postcard")).exists());
+        if a["kept"] == true {
+            assert!(a["fit_gain_pp"].as_f64().unwrap() > 0.0, "seed {seed}: {a}");
+        } else {
+            // Measured: never kept here (ΔBIC ≥ 0: the Kalman gain already re-anchors the
+            // prediction on the measured yaw rate); the input model is written unchanged.
+            let w = a["written"].as_str().unwrap();
+            assert!(w == "input" || w == "refit", "seed {seed}: written {w}");
+        }
+    }
+
+    // The search for the best predictor over the whole library keeps an effect only where the
+    // held-out records pay for it. Measured: one round, none kept (closest: wind +0.27 pp and
+    // current +0.26 pp at 10 steps, ΔBIC +18.9).
+    let more_json = dir.join("more-report.json");
+    let mut args: Vec<String> = vec![
+        "augment".into(),
+        "--model".into(),
+        model_blob.to_string_lossy().into_owned(),
+        "--effect".into(),
+        "none".into(),
+        "--more".into(),
+    ];
+    for t in TRIALS {
+        args.extend(["--data".into(), data(t)]);
+    }
+    args.extend([
+        "--seed".into(),
+        "1".into(),
+        "--out".into(),
+        dir.join("more").to_string_lossy().into_owned(),
+        "--json".into(),
+        more_json.to_string_lossy().into_owned(),
+    ]);
+    run(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    let m = json(&more_json);
+    let added: Vec<&str> = m["more"]["added"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e.as_str().unwrap())
+        .collect();
+    for round in m["more"]["rounds"].as_array().unwrap() {
+        for t in round["tried"].as_array().unwrap() {
+            if t["kept"] == true {
+                assert!(t["fit_gain_pp"].as_f64().unwrap() > 0.0, "{t}");
+                assert!(added.contains(&t["effect"].as_str().unwrap()), "{t}");
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
