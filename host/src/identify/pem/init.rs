@@ -443,6 +443,37 @@ mod tests {
         assert!(diff(&k, &truth.k) < 0.3, "k {k:?} vs {:?}", truth.k);
     }
 
+    /// Windows that hold a missing y are left out, and so are the state pairs across the
+    /// gap: with 30 samples missing in the middle the start lands as near the truth.
+    #[test]
+    fn subspace_start_skips_the_windows_of_a_gap() {
+        let truth = super::super::testdata::truth();
+        let mut rec = super::super::testdata::record(3, 2000);
+        for v in &mut rec.y[985..1015] {
+            *v = f64::NAN;
+        }
+        let ut = rec.u.clone();
+        let recs = std::slice::from_ref(&rec);
+        let uts = std::slice::from_ref(&ut);
+        // 2000 − 40 window starts, less the 30 + 40 that touch the gap
+        assert_eq!(hankel_windows(recs, uts, 20).count(), 2000 - 40 - 70);
+        let (a, b, _) = subspace(recs, uts, 4).unwrap();
+        let moduli = |a: &[f64]| {
+            let mut p = vec![1.0];
+            p.extend(a.iter().rev().map(|v| -v));
+            let mut r: Vec<f64> = poly::roots(&p).iter().map(|z| z.norm()).collect();
+            r.sort_by(f64::total_cmp);
+            r
+        };
+        let (pe, pt) = (moduli(&a), moduli(&truth.a));
+        for (x, y) in pe.iter().zip(&pt) {
+            assert!((x - y).abs() < 0.05, "{pe:?} vs {pt:?}");
+        }
+        let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let db: Vec<f64> = b.iter().zip(&truth.b).map(|(p, q)| p - q).collect();
+        assert!(norm(&db) / norm(&truth.b) < 0.1, "b {b:?} vs {:?}", truth.b);
+    }
+
     /// Too few samples for the block size: no start rather than a bad one.
     #[test]
     fn subspace_start_needs_enough_samples() {
