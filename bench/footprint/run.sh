@@ -68,6 +68,7 @@ if [[ -z $yawcast ]]; then
     yawcast="$target_dir/ci/yawcast"
 fi
 [[ -x $yawcast ]] || { echo "run.sh: $yawcast is not an executable" >&2; exit 2; }
+yawcast="$(realpath "$yawcast")"
 work="${work:-$target_dir/bench-footprint/$samples}"
 mkdir -p "$work/time" "$work/out"
 cd "$work"
@@ -78,7 +79,11 @@ make_record() { # file samples seed [simulate flags…]
     shift 3
     if [[ ! -s $f ]]; then
         echo "simulating $f ($n samples)..." >&2
-        "$yawcast" simulate --duration "$n" --ts 1 --seed "$seed" --out "$f" "$@" >/dev/null 2>&1
+        "$yawcast" simulate --duration "$n" --ts 1 --seed "$seed" --out "$f" "$@" \
+            >"out/simulate-$f.log" 2>&1 || {
+            echo "run.sh: simulating $f failed, see $work/out/simulate-$f.log" >&2
+            exit 1
+        }
     fi
 }
 make_record ref.csv "$samples" 1
