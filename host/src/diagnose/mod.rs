@@ -143,7 +143,8 @@ pub const WINDOW_BLOCK: usize = 2_000;
 /// most [`WINDOW`] samples and is used whole. Each record gets a share of the
 /// `WINDOW / WINDOW_BLOCK` blocks in proportion to its length (at least one), as blocks of
 /// `min(WINDOW_BLOCK, its length)` samples, the first at its start, the last at its end and
-/// the others evenly between; block names are `name@first-sample`.
+/// the others evenly between; block names are `name@first-sample`. `None` too when the
+/// blocks would be the whole records (many records shorter than a block).
 ///
 /// ```
 /// use yawcast::{diagnose::{window, WINDOW_BLOCK}, io::data::Record};
@@ -154,6 +155,8 @@ pub const WINDOW_BLOCK: usize = 2_000;
 /// assert_eq!(blocks[1].name, "long@19600");
 /// assert_eq!(blocks[5].t[WINDOW_BLOCK - 1], 99_999.0);
 /// assert!(window(&[r.slice(0, 12_000)]).is_none());
+/// // ten records of 1 800 samples: one block each would be each whole record
+/// assert!(window(&vec![r.slice(0, 1_800); 10]).is_none());
 /// ```
 pub fn window(recs: &[Record]) -> Option<Vec<Record>> {
     let total: usize = recs.iter().map(Record::len).sum();
@@ -173,7 +176,9 @@ pub fn window(recs: &[Record]) -> Option<Vec<Record>> {
             out.push(b);
         }
     }
-    Some(out)
+    // many short records: one whole record each is no window at all
+    let kept: usize = out.iter().map(Record::len).sum();
+    (kept < total).then_some(out)
 }
 
 /// Steps of the progress bar besides the bootstrap replicates and the refit: the
