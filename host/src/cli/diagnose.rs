@@ -117,6 +117,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
         null_reps: args.null_reps,
         alpha: args.alpha,
         confirm: !args.no_confirm,
+        progress: true,
         ..DiagnoseConfig::default()
     };
     let d = diagnose(&model, &reference, &est, &val, &cfg).map_err(bad)?;

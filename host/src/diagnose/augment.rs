@@ -863,17 +863,35 @@ fn try_effect(
 
     // candidate
     let (cand, search_note) = if kind.is_actuator() {
-        match choose_actuator(kind, model, &base.model, est_part, cfg) {
+        // the structural parameter is searched on blocks of records longer than the
+        // diagnosis window (`crate::diagnose::window`); the chosen structure is then
+        // identified on all of them
+        let blocks = crate::diagnose::window(est_part);
+        let search_on = blocks.as_deref().unwrap_or(est_part);
+        match choose_actuator(kind, model, &base.model, search_on, cfg) {
             Some(c) => {
-                let note = format!(
+                let mut note = format!(
                     "{} grid values scored with θ frozen, {} re-identified, best {}",
                     c.scored,
                     c.reidentified,
                     describe(&Effect::zero(kind, c.value), model.ts)
                 );
+                if let Some(b) = &blocks {
+                    note.push_str(&format!(
+                        "; searched on {} blocks of up to {} samples spread over the records",
+                        b.len(),
+                        crate::diagnose::WINDOW_BLOCK
+                    ));
+                }
                 // the chosen value's structure identified as the baseline was
-                let fin = reidentify_final(est_part, &c.rep.model, &[], cfg).unwrap_or(c.rep);
-                (Some(fin), note)
+                let fin = reidentify_final(est_part, &c.rep.model, &[], cfg);
+                // (the search's own fit only stands in when it was made on the same records)
+                let fin = match (fin, blocks) {
+                    (Ok(f), _) => Some(f),
+                    (Err(_), None) => Some(c.rep),
+                    (Err(_), Some(_)) => None,
+                };
+                (fin, note)
             }
             None => (None, "no usable grid value".to_string()),
         }

@@ -73,7 +73,7 @@ impl Horizon {
 }
 
 /// Full predictor state: x̂, the delay line, the actuator position and the heading.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct State {
     /// State estimate x̂ (first `n` entries used).
     pub x: [f64; MAX_N],
@@ -83,6 +83,26 @@ pub struct State {
     pub u_prev: f64,
     /// Integrated heading ψ̂ (deg).
     pub psi: f64,
+}
+
+impl Clone for State {
+    fn clone(&self) -> State {
+        State {
+            x: self.x,
+            delay: self.delay.clone(),
+            u_prev: self.u_prev,
+            psi: self.psi,
+        }
+    }
+
+    /// Copies without allocating when the delay lines have the same length (the k-step
+    /// passes restart from the filter's state at every sample).
+    fn clone_from(&mut self, o: &State) {
+        self.x = o.x;
+        self.delay.clone_from(&o.delay);
+        self.u_prev = o.u_prev;
+        self.psi = o.psi;
+    }
 }
 
 /// The model's effects unpacked for fast stepping.
@@ -326,17 +346,15 @@ pub fn k_steps(model: &Model, rec: &Record, x0: &[f64], horizons: &[usize]) -> V
     let kmax = hs.iter().copied().max().unwrap_or(1);
     let s = Stepper::new(model);
     let n = rec.len();
-    let mut states = Vec::with_capacity(n);
     let mut st = s.initial(x0, psi0(rec));
-    for t in 0..n {
-        states.push(st.clone());
-        s.step(&mut st, rec.u[t], rec.y[t], psi_at(rec, t));
-    }
     let mut out = vec![vec![0.0; n]; hs.len()];
+    // the open-loop pass from `start` needs only the filter's state there: it runs as the
+    // filter passes, so no state sequence is kept
+    let mut w = st.clone();
     for start in 0..n {
         // sample t = start + j is predicted j + 1 steps ahead: this pass serves horizon h at
         // t = start + h − 1, and the pass from 0 every t < h − 1
-        let mut w = states[start].clone();
+        w.clone_from(&st);
         let last = kmax.min(n - start);
         for j in 0..last {
             let t = start + j;
@@ -350,6 +368,7 @@ pub fn k_steps(model: &Model, rec: &Record, x0: &[f64], horizons: &[usize]) -> V
                 s.step(&mut w, rec.u[t], f64::NAN, None);
             }
         }
+        s.step(&mut st, rec.u[start], rec.y[start], psi_at(rec, start));
     }
     out
 }
