@@ -77,11 +77,24 @@ fn kvlcc2_writes_the_usual_columns_seeded() {
         .collect();
     assert!((r[0] - (7.0f64 / 320.0).sqrt()).abs() < 1e-6, "{r:?}");
     assert!((1.0..1.4).contains(&r[4]), "{r:?}");
+    let js = d.join("s.json");
     let mar = simulate(
         &d,
         "mar.csv",
-        &["--world", "mariner", "--input", "zigzag:10/10"],
+        &[
+            "--world",
+            "mariner",
+            "--input",
+            "zigzag:10/10",
+            "--json",
+            js.to_str().unwrap(),
+        ],
     );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&js).unwrap()).unwrap();
+    assert_eq!(summary["world"], "mariner");
+    assert_eq!(summary["ship"], "Mariner (Abkowitz, Lpp 160.93 m)");
+    assert_eq!(summary["records"][0]["samples"], 120);
     assert!(mar.starts_with("t_s,delta_deg,r_degps,psi_deg,u_mps\n"));
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -20,9 +20,10 @@ pub struct SimulateArgs {
     pub ship: Option<PathBuf>,
     /// Simulator: `lng` (the built-in 1:24 LNG carrier, pods, Ts 1 s), `kvlcc2` (the KVLCC2
     /// tanker by the MMG standard method, full scale L_pp 320 m, Ts 1 s) or `mariner` (the
-    /// Mariner cargo ship, Abkowitz-type, L_pp 160.93 m, Ts 1 s). The new worlds carry
-    /// gusting wind, a background yaw disturbance and real sensor errors; their `--effect`s
-    /// are the built-in ship's carried over to the hull.
+    /// Mariner cargo ship, Abkowitz-type, L_pp 160.93 m, Ts 1 s). The new worlds add a
+    /// background yaw disturbance, gyro and compass errors and, with `--effect wind`, gusts;
+    /// their `--effect`s are the built-in ship's carried over to the hull, their `prbs`
+    /// holds stretched by the hull's L/U.
     #[arg(long, value_name = "NAME", default_value = "lng")]
     pub world: String,
     /// Length between perpendiculars (m) of a Froude-scaled `--world kvlcc2` (speeds and
