@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
-use yawcast::sim::{self, InputSpec, NoiseSpec, Scenario, Ship, SimEffect};
+use yawcast::sim::{self, InputSpec, NoiseSpec, Scenario, Ship, SimEffect, World, WorldKind};
 use yawcast_shared::model::EffectKind;
 
 use super::common::{bad, JsonArg, Outputs, SeedArg};
@@ -15,9 +15,21 @@ use super::common::{bad, JsonArg, Outputs, SeedArg};
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
     /// Ship file (TOML; copy `host/ships/lng_1to24.toml` or write it with `--save-ship`).
-    /// Default: the built-in 1:24 LNG carrier.
+    /// Default: the built-in 1:24 LNG carrier. Only with `--world lng`.
     #[arg(long, value_name = "SHIP.toml")]
     pub ship: Option<PathBuf>,
+    /// Simulator: `lng` (the built-in 1:24 LNG carrier, pods, Ts 1 s), `kvlcc2` (the KVLCC2
+    /// tanker by the MMG standard method, full scale L_pp 320 m, Ts 1 s) or `mariner` (the
+    /// Mariner cargo ship, Abkowitz-type, L_pp 160.93 m, Ts 1 s). The new worlds add a
+    /// background yaw disturbance, gyro and compass errors and, with `--effect wind`, gusts;
+    /// their `--effect`s are the built-in ship's carried over to the hull, their `prbs`
+    /// holds stretched by the hull's L/U.
+    #[arg(long, value_name = "NAME", default_value = "lng")]
+    pub world: String,
+    /// Length between perpendiculars (m) of a Froude-scaled `--world kvlcc2` (speeds and
+    /// times by √(L/320); the default Ts too).
+    #[arg(long, value_name = "L_M")]
+    pub scale: Option<f64>,
     /// Switch on a library effect at its canonical strength (repeatable): bias, gyro-bias,
     /// dead-time, rate-limit, saturation, asymmetry, nonlinear-damping, wind, current, dead-band.
     #[arg(long, value_name = "NAME")]
@@ -28,9 +40,9 @@ pub struct SimulateArgs {
     /// Record length (s).
     #[arg(long, value_name = "S", default_value_t = 1800.0)]
     pub duration: f64,
-    /// Sample time (s).
-    #[arg(long, value_name = "S", default_value_t = 1.0)]
-    pub ts: f64,
+    /// Sample time (s); default 1, on a scaled kvlcc2 √(L/320).
+    #[arg(long, value_name = "S")]
+    pub ts: Option<f64>,
     /// Command: `prbs` (identification input, random switching, 5–20°), `zigzag:10/10`,
     /// `step:15` (step at t = 10 s) or `constant:10`.
     #[arg(long, value_name = "KIND", default_value = "prbs")]
@@ -80,6 +92,7 @@ struct Written {
 struct Summary {
     command: &'static str,
     seed: u64,
+    world: &'static str,
     ship: String,
     effects: Vec<SimEffect>,
     records: Vec<Written>,
@@ -140,6 +153,21 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             return Err(bad(format!("{flag} {v}: expected a finite number ≥ 0")));
         }
     }
+    let kind = WorldKind::from_name(&args.world).ok_or_else(|| {
+        let names: Vec<&str> = WorldKind::ALL.iter().map(|k| k.name()).collect();
+        bad(format!(
+            "--world {:?}: unknown world (expected one of {})",
+            args.world,
+            names.join(", ")
+        ))
+    })?;
+    if kind != WorldKind::Lng && (args.ship.is_some() || args.save_ship.is_some()) {
+        return Err(bad(format!(
+            "--ship and --save-ship are for the built-in ship family (--world lng), not --world {}",
+            kind.name()
+        )));
+    }
+    let world = World::new(kind, args.scale).map_err(|e| bad(format!("--scale: {e}")))?;
     let records: Vec<PathBuf> = match &args.out {
         Some(out) => (1..=args.records)
             .map(|i| numbered(out, i, args.records))
@@ -162,7 +190,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
                 names.join(", ")
             ))
         })?;
-        effects.push(SimEffect::hidden(kind, args.strength));
+        effects.push(world.hidden(kind, args.strength));
     }
     if !(args.strength.is_finite() && args.strength > 0.0) {
         return Err(bad(format!(
@@ -170,10 +198,11 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             args.strength
         )));
     }
-    if !(args.duration.is_finite() && args.ts.is_finite() && args.ts > 0.0 && args.duration > 0.0) {
+    let ts = args.ts.unwrap_or_else(|| world.default_ts());
+    if !(args.duration.is_finite() && ts.is_finite() && ts > 0.0 && args.duration > 0.0) {
         return Err(bad("--duration and --ts must be positive numbers"));
     }
-    let n_samples = (args.duration / args.ts).round() as usize;
+    let n_samples = (args.duration / ts).round() as usize;
     if args.records == 0 {
         return Err(bad("--records: expected at least 1"));
     }
@@ -184,9 +213,12 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     }
     let scenario = Scenario {
         name: "sim".into(),
-        ts: args.ts,
+        ts,
         n_samples,
-        input: parse_input(&args.input)?,
+        input: match parse_input(&args.input)? {
+            InputSpec::Prbs { .. } => world.default_input(),
+            other => other,
+        },
         noise: NoiseSpec {
             gyro_std_degps: args.gyro_noise,
             heading_std_deg: args.heading_noise,
@@ -203,7 +235,11 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let mut done = Vec::new();
     if args.out.is_some() {
         let seeds: Vec<u64> = (0..args.records as u64).map(|i| seed + i).collect();
-        let recs = sim::simulate_many(&ship, &scenario, &seeds).map_err(bad)?;
+        let recs = match args.ship {
+            Some(_) => sim::simulate_many(&ship, &scenario, &seeds),
+            None => world.simulate_many(&scenario, &seeds),
+        }
+        .map_err(bad)?;
         for ((rec, s), path) in recs.iter().zip(&seeds).zip(&records) {
             outputs.add(path, yawcast::io::data::csv_text(rec).into_bytes());
             done.push(format!(
@@ -238,7 +274,11 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         &Summary {
             command: "simulate",
             seed,
-            ship: ship.name.clone(),
+            world: kind.name(),
+            ship: match args.ship {
+                Some(_) => ship.name.clone(),
+                None => world.name(),
+            },
             effects,
             records: written,
         },

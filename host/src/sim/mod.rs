@@ -48,6 +48,7 @@ mod effects;
 mod inputs;
 mod manoeuvres;
 mod ship;
+mod worlds;
 
 pub use effects::{
     SimEffect, HIDDEN_ASYMMETRY, HIDDEN_BIAS_NM, HIDDEN_CURRENT_MPS, HIDDEN_DEAD_TIME_S,
@@ -58,6 +59,8 @@ pub use manoeuvres::{turning_circle, zigzag, TurningResult, ZigzagResult};
 pub use ship::{
     Actuator, HullCoefficients, MainParticulars, Pods, Ship, Windage, DEFAULT_SHIP_TOML,
 };
+
+pub use worlds::{World, WorldKind};
 
 use dynamics::{Model, NX};
 

@@ -1,0 +1,1175 @@
+//! Test worlds: ship simulators beside the built-in one, independent of it in hull and
+//! equations, so a rule tuned on one world can be checked on another.
+//!
+//! - [`WorldKind::Lng`]: the built-in 1:24 LNG carrier ([`simulate`](super::simulate),
+//!   unchanged).
+//! - [`WorldKind::Kvlcc2`]: the KVLCC2 tanker by the MMG standard method (Yasukawa &
+//!   Yoshimura 2015), full scale (`L_pp` 320 m) or Froude-scaled to any `L_pp`.
+//! - [`WorldKind::Mariner`]: the Mariner-class cargo ship, an Abkowitz-type model
+//!   (Chislett & Strøm-Tejsen 1965), full scale (`L_pp` 160.93 m).
+//!
+//! The two new worlds share one environment and one integrator:
+//!
+//! - **State** `[u, v, r, x_N, y_E, ψ]` with `u, v` the velocity *through the water* in body
+//!   axes. A current is uniform and steady in the earth frame, so the water is an inertial
+//!   frame and the hull's equations hold in it unchanged: the current carries the ship
+//!   (`ẋ_N, ẏ_E` and the logged speed over ground include it) and exerts no yaw moment.
+//! - **Wind**: relative wind (the ship's velocity over ground minus the true wind) with
+//!   Blendermann's (1994) coefficient curves for the hull's ship type ([`env::Windage`]);
+//!   the true wind's speed gusts as `V̄(1 + g(t))`, `g` first-order with a 10 % standard
+//!   deviation and a 20 s time constant (Froude-scaled). The ship's own motion through still
+//!   air is always felt.
+//! - **Background yaw disturbance** in every record (reference and trials alike): a
+//!   first-order random yaw moment whose standard deviation is what 0.5° of rudder gives at
+//!   the approach speed, time constant `L_pp/U`.
+//! - **Sensors**: the rate gyro's white noise ([`NoiseSpec`](super::NoiseSpec)) on top of a
+//!   fibre-optic gyro's bias instability (0.002 °/s, 10 min) and resolution (0.001 °/s); the
+//!   compass's white noise on top of a gyrocompass's slow error (0.1°, 2 min) and its 0.1°
+//!   resolution.
+//! - **Steering gear**: dead time → angle limit → rate limit → first-order servo lag, as on
+//!   the built-in ship, with each hull's own limits.
+//! - **Effects** ([`SimEffect`]) act as on the built-in ship, in the world's own units:
+//!   `bias` a steady yaw moment (N·m), `gyro-bias` an offset of the measured rate,
+//!   `dead-time`, `rate-limit` and `saturation` the gear, `asymmetry` the rudder's
+//!   starboard effectiveness, `nonlinear-damping` a Norrbin term `−n_rr ½ρL⁴d r|r|`, `wind`
+//!   and `current` the environment. [`World::hidden`] gives the canonical strengths of the
+//!   built-in ship carried over to the hull (below).
+//!
+//! The random streams of one seed are independent: input, heading and white noise as on
+//! the built-in ship, the background disturbance, the gusts and the sensor drifts each on
+//! their own, so switching an effect on changes nothing else in the record.
+//!
+//! ```
+//! use yawcast::sim::{Scenario, World, WorldKind};
+//! let w = World::new(WorldKind::Mariner, None).unwrap();
+//! let rec = w.simulate(&Scenario { n_samples: 300, ..Scenario::default() }, 1).unwrap();
+//! assert_eq!(rec.len(), 300);
+//! let sog = rec.speed.as_ref().unwrap();
+//! assert!(sog[0] > 7.0 && sog[0] < 8.0, "{}", sog[0]);
+//! ```
+
+use rayon::prelude::*;
+use yawcast_shared::model::EffectKind;
+
+use super::dynamics::{self, Model};
+use super::inputs::{self, InputSpec, ZigZagLogic};
+use super::{NoiseSpec, Scenario, Ship, SimEffect, SimError, TurningResult, ZigzagResult};
+use crate::io::data::Record;
+
+pub(crate) mod env;
+mod kvlcc2;
+mod mariner;
+
+use env::{gauss_markov, quantise, Sensors, Windage};
+
+/// Random stream of the background yaw disturbance.
+const STREAM_BACKGROUND: u64 = 16;
+/// Random stream of the gusts.
+const STREAM_GUST: u64 = 17;
+/// Random stream of the sensor drifts.
+const STREAM_SENSORS: u64 = 18;
+/// Gust standard deviation (fraction of the mean wind speed).
+const GUST_STD: f64 = 0.10;
+/// Gust time constant at full scale (s).
+const GUST_TAU_S: f64 = 20.0;
+/// Background yaw disturbance: standard deviation in degrees of rudder.
+const BACKGROUND_RUDDER_DEG: f64 = 0.5;
+/// Scale of the built-in ship (its full-scale speeds are its own × √24).
+const LNG_SCALE: f64 = 24.0;
+
+/// Which ship simulator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum WorldKind {
+    /// The built-in 1:24 LNG carrier (azimuth pods, MMG-style hull).
+    Lng,
+    /// KVLCC2 by the MMG standard method (Yasukawa & Yoshimura 2015).
+    Kvlcc2,
+    /// The Mariner-class cargo ship, Abkowitz-type (Chislett & Strøm-Tejsen 1965).
+    Mariner,
+}
+
+impl WorldKind {
+    /// Every world, the built-in one first.
+    pub const ALL: [WorldKind; 3] = [WorldKind::Lng, WorldKind::Kvlcc2, WorldKind::Mariner];
+
+    /// The stable name (`lng`, `kvlcc2`, `mariner`).
+    ///
+    /// ```
+    /// use yawcast::sim::WorldKind;
+    /// assert_eq!(WorldKind::from_name("kvlcc2"), Some(WorldKind::Kvlcc2));
+    /// assert_eq!(WorldKind::Mariner.name(), "mariner");
+    /// ```
+    pub fn name(self) -> &'static str {
+        match self {
+            WorldKind::Lng => "lng",
+            WorldKind::Kvlcc2 => "kvlcc2",
+            WorldKind::Mariner => "mariner",
+        }
+    }
+
+    /// The world of a stable name.
+    pub fn from_name(name: &str) -> Option<WorldKind> {
+        WorldKind::ALL.into_iter().find(|k| k.name() == name)
+    }
+}
+
+/// A steering gear.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Gear {
+    /// First-order servo time constant (s).
+    pub tau_s: f64,
+    /// Angle limit (deg).
+    pub limit_deg: f64,
+    /// Rate limit (deg/s).
+    pub rate_degps: f64,
+}
+
+/// A hull of a test world: its particulars and its equations of motion.
+pub(crate) trait Hull: std::fmt::Debug + Send + Sync {
+    /// A name for reports.
+    fn name(&self) -> String;
+    /// Length between perpendiculars (m).
+    fn lpp(&self) -> f64;
+    /// Draft (m).
+    fn draft(&self) -> f64;
+    /// Water density (kg/m³).
+    fn rho(&self) -> f64;
+    /// Approach speed through the water on a straight course at δ = 0 (m/s).
+    fn u0(&self) -> f64;
+    /// Froude time scale against full scale (`√(1/λ)`; 1 at full scale).
+    fn froude_time(&self) -> f64;
+    /// The steering gear.
+    fn gear(&self) -> Gear;
+    /// Above-water geometry and wind coefficients.
+    fn windage(&self) -> Windage;
+    /// Sets the `asymmetry` effect's extra rudder effectiveness to starboard.
+    fn set_asymmetry(&mut self, gain: f64);
+    /// Accelerations `(u̇, v̇, ṙ)` at the water-relative body velocities `s = [u, v, r]`
+    /// and rudder angle δ (rad, positive to starboard), with external loads `ext`
+    /// (`X`, `Y` in N, `N` in N·m).
+    fn accel(&self, s: [f64; 3], delta: f64, ext: [f64; 3]) -> [f64; 3];
+}
+
+/// One test world: a simulator and its scale.
+///
+/// ```
+/// use yawcast::sim::{World, WorldKind};
+/// let w = World::new(WorldKind::Kvlcc2, Some(7.0)).unwrap();
+/// assert!((w.default_ts() - (7.0f64 / 320.0).sqrt()).abs() < 1e-12);
+/// assert!(World::new(WorldKind::Mariner, Some(7.0)).is_err());
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct World {
+    kind: WorldKind,
+    lpp: Option<f64>,
+}
+
+impl World {
+    /// The world `kind`, at `L_pp = scale_lpp` metres when given (KVLCC2 only: the
+    /// built-in ship is a model already, the Mariner model is full scale only).
+    ///
+    /// # Errors
+    /// [`SimError::Invalid`] (`world.scale`) for a scale on another world or outside
+    /// 1–1000 m.
+    pub fn new(kind: WorldKind, scale_lpp: Option<f64>) -> Result<World, SimError> {
+        if let Some(l) = scale_lpp {
+            if kind != WorldKind::Kvlcc2 {
+                return Err(SimError::invalid(
+                    "world.scale",
+                    l,
+                    "no scale: only kvlcc2 takes one",
+                ));
+            }
+            super::ship::within("world.scale", l, 1.0, 1000.0)?;
+        }
+        Ok(World {
+            kind,
+            lpp: scale_lpp,
+        })
+    }
+
+    /// Which world.
+    pub fn kind(&self) -> WorldKind {
+        self.kind
+    }
+
+    fn hull(&self) -> Option<Box<dyn Hull>> {
+        match self.kind {
+            WorldKind::Lng => None,
+            WorldKind::Kvlcc2 => Some(Box::new(kvlcc2::Kvlcc2::new(
+                self.lpp.unwrap_or(kvlcc2::LPP_FULL),
+            ))),
+            WorldKind::Mariner => Some(Box::new(mariner::Mariner::new())),
+        }
+    }
+
+    /// A name for reports.
+    ///
+    /// ```
+    /// use yawcast::sim::{World, WorldKind};
+    /// let w = World::new(WorldKind::Kvlcc2, None).unwrap();
+    /// assert_eq!(w.name(), "KVLCC2 (MMG, Lpp 320 m)");
+    /// ```
+    pub fn name(&self) -> String {
+        match self.hull() {
+            Some(h) => h.name(),
+            None => Ship::default_lng().name,
+        }
+    }
+
+    /// The default sample time (s): 1 s at full scale and on the built-in ship,
+    /// Froude-scaled (`√(L_pp/320)` s) on a scaled KVLCC2.
+    pub fn default_ts(&self) -> f64 {
+        self.hull().map_or(1.0, |h| h.froude_time())
+    }
+
+    /// The hull's time `L_pp/U` over the built-in ship's.
+    fn time_ratio(&self) -> f64 {
+        match self.hull() {
+            None => 1.0,
+            Some(h) => {
+                let (l, _, _, u) = lng_reference();
+                (h.lpp() / h.u0()) / (l / u)
+            }
+        }
+    }
+
+    /// The identification input: the built-in ship's PRBS-like sequence (amplitudes 5–20°)
+    /// with its holds (5–30 s) stretched by the hull's time `L_pp/U` over the built-in
+    /// ship's, so the ship answers each hold alike.
+    ///
+    /// ```
+    /// use yawcast::sim::{InputSpec, World, WorldKind};
+    /// let lng = World::new(WorldKind::Lng, None).unwrap();
+    /// assert_eq!(lng.default_input(), InputSpec::default());
+    /// ```
+    pub fn default_input(&self) -> InputSpec {
+        let k = self.time_ratio();
+        match InputSpec::default() {
+            InputSpec::Prbs {
+                amplitudes_deg,
+                min_hold_s,
+                max_hold_s,
+            } if self.kind != WorldKind::Lng => InputSpec::Prbs {
+                amplitudes_deg,
+                min_hold_s: (min_hold_s * k).round(),
+                max_hold_s: (max_hold_s * k).round(),
+            },
+            other => other,
+        }
+    }
+
+    /// The canonical hidden effect of `kind` at `strength` on this world: the built-in
+    /// ship's ([`SimEffect::hidden`]) carried over to the hull. Angles, gains and `n_rr`
+    /// stay; times (dead time) scale with the hull's time `L_pp/U` over the built-in ship's
+    /// and rates (gyro bias, rate limit) with its inverse; the yaw moment keeps its
+    /// non-dimensional value `N/(½ρL²dU²)`; wind and current keep their full-scale speeds
+    /// (the built-in ship's × √24: 14.7 m/s and 1.47 m/s at full strength), Froude-scaled
+    /// to the hull.
+    ///
+    /// ```
+    /// use yawcast::sim::{SimEffect, World, WorldKind};
+    /// use yawcast_shared::model::EffectKind;
+    /// let w = World::new(WorldKind::Mariner, None).unwrap();
+    /// let SimEffect::Wind { speed_mps, .. } = w.hidden(EffectKind::Wind, 1.0) else { panic!() };
+    /// assert!((speed_mps - 3.0 * 24f64.sqrt()).abs() < 1e-12);
+    /// ```
+    pub fn hidden(&self, kind: EffectKind, strength: f64) -> SimEffect {
+        let base = SimEffect::hidden(kind, strength);
+        let Some(h) = self.hull() else {
+            return base;
+        };
+        let t = self.time_ratio();
+        let v = LNG_SCALE.sqrt() * h.froude_time();
+        match base {
+            SimEffect::Bias { yaw_moment_nm } => {
+                let (l, d, rho, u) = lng_reference();
+                let nd = yaw_moment_nm / (0.5 * rho * l * l * d * u * u);
+                let u0 = h.u0();
+                SimEffect::Bias {
+                    yaw_moment_nm: nd * 0.5 * h.rho() * h.lpp().powi(2) * h.draft() * u0 * u0,
+                }
+            }
+            SimEffect::GyroBias { bias_degps } => SimEffect::GyroBias {
+                bias_degps: bias_degps / t,
+            },
+            SimEffect::DeadTime { delay_s } => SimEffect::DeadTime {
+                delay_s: delay_s * t,
+            },
+            SimEffect::RateLimit { rate_degps } => SimEffect::RateLimit {
+                rate_degps: rate_degps / t,
+            },
+            SimEffect::Wind {
+                speed_mps,
+                from_deg,
+            } => SimEffect::Wind {
+                speed_mps: speed_mps * v,
+                from_deg,
+            },
+            SimEffect::Current {
+                speed_mps,
+                towards_deg,
+            } => SimEffect::Current {
+                speed_mps: speed_mps * v,
+                towards_deg,
+            },
+            // angles and non-dimensional gains carry over unchanged
+            SimEffect::Saturation { .. }
+            | SimEffect::DeadBand { .. }
+            | SimEffect::Asymmetry { .. }
+            | SimEffect::NonlinearDamping { .. } => base,
+        }
+    }
+
+    /// Simulates one trial under `scenario` with `seed`, as [`simulate`](super::simulate)
+    /// does for the built-in ship (same channels, same meaning; the speed is over ground);
+    /// on the built-in world it *is* that function, byte for byte.
+    ///
+    /// # Errors
+    /// As [`simulate`](super::simulate).
+    pub fn simulate(&self, scenario: &Scenario, seed: u64) -> Result<Record, SimError> {
+        match self.hull() {
+            None => super::simulate(&Ship::default_lng(), scenario, seed),
+            Some(h) => simulate_hull(h, scenario, seed),
+        }
+    }
+
+    /// One record per seed, in parallel, named `{scenario.name}-{seed}`.
+    ///
+    /// # Errors
+    /// The first error of [`World::simulate`], in seed order.
+    pub fn simulate_many(
+        &self,
+        scenario: &Scenario,
+        seeds: &[u64],
+    ) -> Result<Vec<Record>, SimError> {
+        seeds
+            .par_iter()
+            .map(|&seed| {
+                let mut r = self.simulate(scenario, seed)?;
+                r.name = format!("{}-{seed}", scenario.name);
+                Ok(r)
+            })
+            .collect()
+    }
+
+    /// Turning circle at a constant rudder `delta_deg` from a steady straight approach, in
+    /// calm water and air without disturbances.
+    ///
+    /// # Errors
+    /// As [`turning_circle`](super::turning_circle).
+    pub fn turning_circle(&self, delta_deg: f64) -> Result<TurningResult, SimError> {
+        match self.hull() {
+            None => super::turning_circle(&Ship::default_lng(), delta_deg),
+            Some(h) => turning_hull(h.as_ref(), delta_deg),
+        }
+    }
+
+    /// Zig-zag `delta_deg`/`psi_deg` from a steady straight approach, starting to
+    /// starboard, in calm water and air without disturbances.
+    ///
+    /// # Errors
+    /// As [`zigzag`](super::zigzag).
+    pub fn zigzag(&self, delta_deg: f64, psi_deg: f64) -> Result<ZigzagResult, SimError> {
+        match self.hull() {
+            None => super::zigzag(&Ship::default_lng(), delta_deg, psi_deg),
+            Some(h) => zigzag_hull(h.as_ref(), delta_deg, psi_deg),
+        }
+    }
+}
+
+/// The built-in ship's `(L_pp, d, ρ, U)` (U its equilibrium speed).
+fn lng_reference() -> (f64, f64, f64, f64) {
+    let ship = Ship::default_lng();
+    let u = Model::new(&ship, &[]).equilibrium_speed().unwrap_or(1.0);
+    (ship.main.lpp_m, ship.main.draft_m, ship.main.rho_water, u)
+}
+
+/// The effects' physics on a hull.
+#[derive(Debug, Clone)]
+struct Physics {
+    windage: Windage,
+    bias_nm: f64,
+    n_rr: f64,
+    cubic: bool,
+    gyro_bias: f64,
+    /// True wind velocity, towards (N, E), m/s.
+    wind_ne: (f64, f64),
+    /// Current velocity, towards (N, E), m/s.
+    current_ne: (f64, f64),
+    half_rho_l2d: f64,
+    half_rho_l4d: f64,
+    lpp: f64,
+}
+
+/// One sample's random environment: background moment (N·m) and gust factor.
+#[derive(Debug, Clone, Copy)]
+struct Weather {
+    moment: f64,
+    gust: f64,
+}
+
+const CALM: Weather = Weather {
+    moment: 0.0,
+    gust: 1.0,
+};
+
+impl Physics {
+    /// The physics of `effects` on `hull`, its gear with the gear effects, and the
+    /// `asymmetry` effect's gain (for [`Hull::set_asymmetry`]).
+    fn new(hull: &dyn Hull, effects: &[SimEffect]) -> (Physics, dynamics::Actuator, f64) {
+        let gear = hull.gear();
+        let mut act = dynamics::Actuator {
+            dead_time: 0.0,
+            limit: gear.limit_deg.to_radians(),
+            slew: gear.rate_degps.to_radians(),
+            tau: gear.tau_s,
+            band: 0.0,
+            delta: 0.0,
+        };
+        let (l, d, rho) = (hull.lpp(), hull.draft(), hull.rho());
+        let mut p = Physics {
+            windage: hull.windage(),
+            bias_nm: 0.0,
+            n_rr: 0.0,
+            cubic: false,
+            gyro_bias: 0.0,
+            wind_ne: (0.0, 0.0),
+            current_ne: (0.0, 0.0),
+            half_rho_l2d: 0.5 * rho * l * l * d,
+            half_rho_l4d: 0.5 * rho * l.powi(4) * d,
+            lpp: l,
+        };
+        let mut asym = 0.0;
+        for e in merged(effects) {
+            match e {
+                SimEffect::Bias { yaw_moment_nm } => p.bias_nm = yaw_moment_nm,
+                SimEffect::GyroBias { bias_degps } => p.gyro_bias = bias_degps,
+                SimEffect::DeadTime { delay_s } => act.dead_time = delay_s,
+                SimEffect::RateLimit { rate_degps } => {
+                    act.slew = act.slew.min(rate_degps.to_radians());
+                }
+                SimEffect::Saturation { limit_deg } => {
+                    act.limit = act.limit.min(limit_deg.to_radians());
+                }
+                SimEffect::DeadBand { width_deg } => act.band = width_deg.to_radians(),
+                SimEffect::Asymmetry { starboard_gain } => asym = starboard_gain,
+                SimEffect::NonlinearDamping { n_rr, cubic } => {
+                    p.n_rr = n_rr;
+                    p.cubic = cubic;
+                }
+                SimEffect::Wind {
+                    speed_mps,
+                    from_deg,
+                } => {
+                    let a = from_deg.to_radians();
+                    p.wind_ne = (-speed_mps * a.cos(), -speed_mps * a.sin());
+                }
+                SimEffect::Current {
+                    speed_mps,
+                    towards_deg,
+                } => {
+                    let a = towards_deg.to_radians();
+                    p.current_ne = (speed_mps * a.cos(), speed_mps * a.sin());
+                }
+            }
+        }
+        (p, act, asym)
+    }
+
+    /// Current and (gusting) true wind in body axes at heading ψ.
+    #[inline]
+    fn body(&self, psi: f64, gust: f64) -> ((f64, f64), (f64, f64)) {
+        let (sp, cp) = psi.sin_cos();
+        let rot = |(n, e): (f64, f64)| (n * cp + e * sp, -n * sp + e * cp);
+        let (wn, we) = self.wind_ne;
+        (rot(self.current_ne), rot((wn * gust, we * gust)))
+    }
+
+    /// Air-relative body velocity (the apparent wind comes from its direction).
+    #[inline]
+    fn air(&self, s: &[f64; 6], w: Weather) -> (f64, f64) {
+        let ((uc, vc), (uw, vw)) = self.body(s[5], w.gust);
+        (s[0] + uc - uw, s[1] + vc - vw)
+    }
+
+    /// Speed over ground.
+    fn sog(&self, s: &[f64; 6]) -> f64 {
+        let ((uc, vc), _) = self.body(s[5], 1.0);
+        (s[0] + uc).hypot(s[1] + vc)
+    }
+
+    #[inline]
+    fn deriv(&self, hull: &dyn Hull, s: &[f64; 6], delta: f64, w: Weather) -> [f64; 6] {
+        let (ua, va) = self.air(s, w);
+        let (xa, ya, na) = self.windage.loads(ua, va);
+        let mut n = na + self.bias_nm + w.moment;
+        let r = s[2];
+        if self.n_rr != 0.0 {
+            n -= if self.cubic {
+                let u2 = (s[0] * s[0] + s[1] * s[1]).max(1e-8);
+                let rp = r * self.lpp / u2.sqrt();
+                self.n_rr * self.half_rho_l2d * u2 * rp * rp * rp
+            } else {
+                self.n_rr * self.half_rho_l4d * r * r.abs()
+            };
+        }
+        let a = hull.accel([s[0], s[1], r], delta, [xa, ya, n]);
+        let (sp, cp) = s[5].sin_cos();
+        let (cn, ce) = self.current_ne;
+        [
+            a[0],
+            a[1],
+            a[2],
+            s[0] * cp - s[1] * sp + cn,
+            s[0] * sp + s[1] * cp + ce,
+            r,
+        ]
+    }
+
+    fn rk4(&self, hull: &dyn Hull, s: &mut [f64; 6], delta: f64, dt: f64, w: Weather) {
+        let k1 = self.deriv(hull, s, delta, w);
+        let mut tmp = [0.0; 6];
+        for i in 0..6 {
+            tmp[i] = s[i] + 0.5 * dt * k1[i];
+        }
+        let k2 = self.deriv(hull, &tmp, delta, w);
+        for i in 0..6 {
+            tmp[i] = s[i] + 0.5 * dt * k2[i];
+        }
+        let k3 = self.deriv(hull, &tmp, delta, w);
+        for i in 0..6 {
+            tmp[i] = s[i] + dt * k3[i];
+        }
+        let k4 = self.deriv(hull, &tmp, delta, w);
+        for i in 0..6 {
+            s[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+        }
+    }
+}
+
+/// The effects in force: of several of one kind, the last.
+fn merged(effects: &[SimEffect]) -> Vec<SimEffect> {
+    let mut out: Vec<SimEffect> = Vec::new();
+    for e in effects {
+        match out.iter_mut().find(|x| x.kind() == e.kind()) {
+            Some(x) => *x = *e,
+            None => out.push(*e),
+        }
+    }
+    out
+}
+
+/// Settings of one run on a hull.
+struct HullRun<'a> {
+    hull: &'a dyn Hull,
+    phys: &'a Physics,
+    act: dynamics::Actuator,
+    ts: f64,
+    n: usize,
+    dt_max: f64,
+    warmup_s: f64,
+    psi0_deg: f64,
+    /// The weather of each sample (empty: calm).
+    weather: &'a [Weather],
+}
+
+/// Integrates over `spec.n` samples: at each sample `observe` sees the state and the
+/// weather (and may stop the run), then `command` gives the command (deg) held until the
+/// next sample.
+fn run_hull(
+    mut spec: HullRun<'_>,
+    mut command: impl FnMut(usize, &[f64; 6]) -> f64,
+    mut observe: impl FnMut(usize, &[f64; 6], Weather) -> bool,
+) -> Result<(), SimError> {
+    let (hull, phys) = (spec.hull, spec.phys);
+    let u0 = hull.u0();
+    let mut s = [u0, 0.0, 0.0, 0.0, 0.0, spec.psi0_deg.to_radians()];
+    let nsub = (spec.ts / spec.dt_max).ceil().max(1.0) as usize;
+    let dt = spec.ts / nsub as f64;
+    let nwarm = (spec.warmup_s / dt).ceil() as usize;
+    let act = &mut spec.act;
+    for _ in 0..nwarm {
+        act.step(0.0, dt);
+        phys.rk4(hull, &mut s, act.delta, dt, CALM);
+    }
+    if nwarm > 0 {
+        s[3] = 0.0;
+        s[4] = 0.0;
+        s[5] = spec.psi0_deg.to_radians();
+    }
+    let mut hist: Vec<f64> = Vec::with_capacity(spec.n);
+    let vmax = 10.0 * u0;
+    for k in 0..spec.n {
+        let t = k as f64 * spec.ts;
+        if !s.iter().all(|x| x.is_finite()) || s[0].abs() > vmax || s[1].abs() > vmax {
+            return Err(SimError::Diverged { t_s: t });
+        }
+        let w = spec.weather.get(k).copied().unwrap_or(CALM);
+        if !observe(k, &s, w) || k + 1 == spec.n {
+            break;
+        }
+        hist.push(command(k, &s));
+        for j in 0..nsub {
+            let tj = t + j as f64 * dt;
+            let tk = (tj - act.dead_time) / spec.ts + 1e-9;
+            let c = if tk < 0.0 {
+                0.0
+            } else {
+                hist[(tk.floor() as usize).min(hist.len() - 1)]
+            };
+            act.step(c.to_radians(), dt);
+            phys.rk4(hull, &mut s, act.delta, dt, w);
+        }
+    }
+    Ok(())
+}
+
+/// The moment (N·m) that turns the hull as `deg` degrees of rudder do at the approach.
+fn rudder_moment(hull: &dyn Hull, deg: f64) -> f64 {
+    let s = [hull.u0(), 0.0, 0.0];
+    let r0 = hull.accel(s, 0.0, [0.0; 3])[2];
+    let rd = hull.accel(s, deg.to_radians(), [0.0; 3])[2];
+    let per_nm = hull.accel(s, 0.0, [0.0, 0.0, 1.0])[2] - r0;
+    (rd - r0) / per_nm
+}
+
+fn simulate_hull(
+    mut hull: Box<dyn Hull>,
+    scenario: &Scenario,
+    seed: u64,
+) -> Result<Record, SimError> {
+    use rand::Rng;
+    scenario.validate()?;
+    let (phys, act, asym) = Physics::new(hull.as_ref(), &scenario.effects);
+    hull.set_asymmetry(asym);
+    let hull: &dyn Hull = hull.as_ref();
+    let n = scenario.n_samples;
+    let ts = scenario.ts;
+    let ft = hull.froude_time();
+    let psi0 = match scenario.initial_heading_deg {
+        Some(h) => h,
+        None => 360.0 * inputs::rng(seed, inputs::STREAM_HEADING).random::<f64>(),
+    };
+    // the world's random processes, one stream each
+    let tau_bg = hull.lpp() / hull.u0();
+    let bg = gauss_markov(
+        &mut inputs::rng(seed, STREAM_BACKGROUND),
+        n,
+        ts,
+        tau_bg,
+        BACKGROUND_RUDDER_DEG.abs() * rudder_moment(hull, 1.0).abs(),
+    );
+    let gust_std = if phys.wind_ne == (0.0, 0.0) {
+        0.0
+    } else {
+        GUST_STD
+    };
+    let gust = gauss_markov(
+        &mut inputs::rng(seed, STREAM_GUST),
+        n,
+        ts,
+        GUST_TAU_S * ft,
+        gust_std,
+    );
+    let weather: Vec<Weather> = bg
+        .iter()
+        .zip(&gust)
+        .map(|(&m, &g)| Weather {
+            moment: m,
+            gust: 1.0 + g,
+        })
+        .collect();
+    let sensors = Sensors::marine(ft);
+    let mut sr = inputs::rng(seed, STREAM_SENSORS);
+    let drift = gauss_markov(
+        &mut sr,
+        n,
+        ts,
+        sensors.gyro_drift_tau_s,
+        sensors.gyro_drift_degps,
+    );
+    let compass = gauss_markov(
+        &mut sr,
+        n,
+        ts,
+        sensors.compass_tau_s,
+        sensors.compass_err_deg,
+    );
+
+    let open = scenario.input.open_loop(n, ts, seed);
+    let mut zz = match scenario.input {
+        InputSpec::ZigZag { delta_deg, psi_deg } => Some(ZigZagLogic::new(delta_deg, psi_deg)),
+        _ => None,
+    };
+    let mut decide = |k: usize, s: &[f64; 6]| match (&open, zz.as_mut()) {
+        (Some(u), _) => u[k],
+        (None, Some(z)) => z.command(s[5].to_degrees()),
+        (None, None) => 0.0,
+    };
+    let mut cmds = Vec::with_capacity(n);
+    let mut states: Vec<([f64; 6], Weather)> = Vec::with_capacity(n);
+    run_hull(
+        HullRun {
+            hull,
+            phys: &phys,
+            act,
+            ts,
+            n,
+            dt_max: scenario.dt_max,
+            warmup_s: scenario.warmup_s,
+            psi0_deg: psi0,
+            weather: &weather,
+        },
+        |k, s| {
+            let c = decide(k, s);
+            cmds.push(c);
+            c
+        },
+        |_, s, w| {
+            states.push((*s, w));
+            true
+        },
+    )?;
+    if let Some((s, _)) = states.last() {
+        if cmds.len() < states.len() {
+            cmds.push(decide(states.len() - 1, s));
+        }
+    }
+    let mut rec = Record {
+        name: scenario.name.clone(),
+        ts,
+        t: (0..n).map(|k| k as f64 * ts).collect(),
+        u: Vec::with_capacity(n),
+        y: Vec::with_capacity(n),
+        psi: Some(Vec::with_capacity(n)),
+        speed: Some(Vec::with_capacity(n)),
+        wind_speed: scenario.log_wind.then(|| Vec::with_capacity(n)),
+        wind_angle: scenario.log_wind.then(|| Vec::with_capacity(n)),
+    };
+    let mut nr = inputs::rng(seed, inputs::STREAM_NOISE);
+    let ns: NoiseSpec = scenario.noise;
+    let mut white = |std: f64| {
+        if std > 0.0 {
+            std * inputs::gauss(&mut nr)
+        } else {
+            0.0
+        }
+    };
+    for (k, (s, w)) in states.iter().enumerate() {
+        rec.u.push(cmds[k]);
+        let g = white(ns.gyro_std_degps);
+        let gyro = s[2].to_degrees() + phys.gyro_bias + drift[k] + g;
+        rec.y.push(quantise(gyro, sensors.gyro_lsb_degps));
+        let h = white(ns.heading_std_deg);
+        let heading = s[5].to_degrees() + compass[k] + h;
+        push(&mut rec.psi, quantise(heading, sensors.compass_lsb_deg));
+        let sn = white(ns.speed_std_mps);
+        push(&mut rec.speed, phys.sog(s) + sn);
+        if scenario.log_wind {
+            let (ua, va) = phys.air(s, *w);
+            push(&mut rec.wind_speed, ua.hypot(va));
+            push(&mut rec.wind_angle, va.atan2(ua).to_degrees());
+        }
+    }
+    Ok(rec)
+}
+
+fn push(v: &mut Option<Vec<f64>>, x: f64) {
+    if let Some(v) = v.as_mut() {
+        v.push(x);
+    }
+}
+
+/// A calm, disturbance-free manoeuvre run on `hull` (its own gear, no effects).
+fn calm_run<'a>(hull: &'a dyn Hull, phys: &'a Physics, act: dynamics::Actuator) -> HullRun<'a> {
+    let ft = hull.froude_time();
+    HullRun {
+        hull,
+        phys,
+        act,
+        ts: 0.25 * ft,
+        n: (7200.0 / 0.25) as usize,
+        dt_max: 0.125 * ft,
+        warmup_s: 60.0 * ft,
+        psi0_deg: 0.0,
+        weather: &[],
+    }
+}
+
+fn turning_hull(hull: &dyn Hull, delta_deg: f64) -> Result<TurningResult, SimError> {
+    if !delta_deg.is_finite() || delta_deg == 0.0 {
+        return Err(SimError::invalid(
+            "delta_deg",
+            delta_deg,
+            "finite and non-zero",
+        ));
+    }
+    let (p, act, _) = Physics::new(hull, &[]);
+    let sg = delta_deg.signum();
+    let mut prev: Option<(f64, f64, f64)> = None;
+    let (mut at90, mut at180) = (None, None);
+    let (mut r_sum, mut sp_sum, mut cnt) = (0.0, 0.0, 0usize);
+    let mut done = false;
+    run_hull(
+        calm_run(hull, &p, act),
+        |_, _| delta_deg,
+        |_, s, _| {
+            let dpsi = sg * s[5].to_degrees();
+            let (x, y) = (s[3], sg * s[4]);
+            if let Some((pp, px, py)) = prev {
+                for (target, slot) in [(90.0, &mut at90), (180.0, &mut at180)] {
+                    if slot.is_none() && pp < target && dpsi >= target {
+                        let w = (target - pp) / (dpsi - pp);
+                        *slot = Some((px + w * (x - px), py + w * (y - py)));
+                    }
+                }
+            }
+            prev = Some((dpsi, x, y));
+            if (360.0..450.0).contains(&dpsi) {
+                r_sum += s[2].to_degrees();
+                sp_sum += p.sog(s);
+                cnt += 1;
+            }
+            done = dpsi >= 450.0;
+            !done
+        },
+    )?;
+    match (at90, at180, done && cnt > 0) {
+        (Some((adv, tr)), Some((_, td)), true) => Ok(TurningResult {
+            advance_m: adv,
+            transfer_m: tr,
+            tactical_diameter_m: td,
+            steady_r_degps: r_sum / cnt as f64,
+            steady_speed_mps: sp_sum / cnt as f64,
+        }),
+        _ => Err(SimError::Manoeuvre {
+            manoeuvre: "turning circle",
+            reason: format!("heading did not change by 450° at δ = {delta_deg}°"),
+        }),
+    }
+}
+
+fn zigzag_hull(hull: &dyn Hull, delta_deg: f64, psi_deg: f64) -> Result<ZigzagResult, SimError> {
+    super::ship::within("delta_deg", delta_deg, 1e-3, 90.0)?;
+    super::ship::within("psi_deg", psi_deg, 1e-3, 180.0)?;
+    let (p, act, _) = Physics::new(hull, &[]);
+    let spec = calm_run(hull, &p, act);
+    let ts = spec.ts;
+    let mut logic = ZigZagLogic::new(delta_deg, psi_deg);
+    let (mut max1, mut min2) = (f64::NEG_INFINITY, f64::INFINITY);
+    let mut t_switch = f64::NAN;
+    let mut switches = 0;
+    run_hull(
+        spec,
+        |_, s| logic.command(s[5].to_degrees()),
+        |k, s, _| {
+            let dpsi = s[5].to_degrees();
+            match switches {
+                1 => max1 = max1.max(dpsi),
+                2 => min2 = min2.min(dpsi),
+                _ => {}
+            }
+            let will_switch = match switches % 2 {
+                0 => dpsi >= psi_deg,
+                _ => dpsi <= -psi_deg,
+            };
+            if will_switch && k > 0 {
+                switches += 1;
+                if switches == 1 {
+                    t_switch = k as f64 * ts;
+                    max1 = dpsi;
+                }
+                if switches == 2 {
+                    min2 = dpsi;
+                }
+            }
+            switches < 3
+        },
+    )?;
+    if switches < 3 {
+        return Err(SimError::Manoeuvre {
+            manoeuvre: "zig-zag",
+            reason: format!("only {switches} of 3 switches"),
+        });
+    }
+    Ok(ZigzagResult {
+        first_overshoot_deg: max1 - psi_deg,
+        second_overshoot_deg: -min2 - psi_deg,
+        time_to_switch_s: t_switch,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quiet(n: usize, effects: Vec<SimEffect>, w: &World) -> Scenario {
+        Scenario {
+            noise: NoiseSpec::none(),
+            initial_heading_deg: Some(30.0),
+            n_samples: n,
+            input: w.default_input(),
+            effects,
+            ..Scenario::default()
+        }
+    }
+
+    fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max)
+    }
+
+    fn mean(v: &[f64]) -> f64 {
+        v.iter().sum::<f64>() / v.len() as f64
+    }
+
+    const NEW: [WorldKind; 2] = [WorldKind::Kvlcc2, WorldKind::Mariner];
+
+    #[test]
+    fn the_lng_world_is_the_built_in_simulator() {
+        let w = World::new(WorldKind::Lng, None).unwrap();
+        let sc = Scenario {
+            n_samples: 300,
+            effects: vec![SimEffect::hidden(EffectKind::Wind, 1.0)],
+            log_wind: true,
+            ..Scenario::default()
+        };
+        let a = w.simulate(&sc, 4).unwrap();
+        assert_eq!(
+            a,
+            super::super::simulate(&Ship::default_lng(), &sc, 4).unwrap()
+        );
+        for k in EffectKind::ALL {
+            assert_eq!(w.hidden(k, 0.7), SimEffect::hidden(k, 0.7));
+        }
+        assert_eq!(w.default_ts(), 1.0);
+        assert_eq!(w.name(), Ship::default_lng().name);
+    }
+
+    #[test]
+    fn canonical_strengths_carry_over_by_the_hull_time() {
+        let (l, _, _, u) = lng_reference();
+        for kind in NEW {
+            let w = World::new(kind, None).unwrap();
+            let t = w.time_ratio();
+            let h = w.hull().unwrap();
+            assert!((t - (h.lpp() / h.u0()) / (l / u)).abs() < 1e-12);
+            println!(
+                "{}: L/U = {:.1} s, {t:.2} × the built-in ship's",
+                kind.name(),
+                h.lpp() / h.u0()
+            );
+            assert_eq!(
+                w.hidden(EffectKind::DeadTime, 1.0),
+                SimEffect::DeadTime { delay_s: 2.0 * t }
+            );
+            assert_eq!(
+                w.hidden(EffectKind::Saturation, 1.0),
+                SimEffect::Saturation { limit_deg: 8.0 }
+            );
+            for k in EffectKind::ALL {
+                w.hidden(k, 1.0).validate("x").unwrap();
+            }
+            let InputSpec::Prbs {
+                min_hold_s,
+                max_hold_s,
+                ..
+            } = w.default_input()
+            else {
+                panic!()
+            };
+            assert_eq!(
+                (min_hold_s, max_hold_s),
+                ((5.0 * t).round(), (30.0 * t).round())
+            );
+        }
+        // a scaled KVLCC2 keeps full-scale wind in Froude proportion
+        let m = World::new(WorldKind::Kvlcc2, Some(7.0)).unwrap();
+        let SimEffect::Wind { speed_mps, .. } = m.hidden(EffectKind::Wind, 1.0) else {
+            panic!()
+        };
+        assert!((speed_mps - 3.0 * 24f64.sqrt() * (7.0f64 / 320.0).sqrt()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_seed_fixes_the_record_and_the_background_is_always_there() {
+        for kind in NEW {
+            let w = World::new(kind, None).unwrap();
+            let sc = quiet(400, Vec::new(), &w);
+            let a = w.simulate(&sc, 11).unwrap();
+            assert_eq!(a, w.simulate(&sc, 11).unwrap());
+            let b = w.simulate(&sc, 12).unwrap();
+            assert_ne!(a.u, b.u);
+            // on a straight course (δ = 0) the background yaw disturbance and the sensors
+            // still move the yaw rate
+            let straight = Scenario {
+                input: InputSpec::Constant { delta_deg: 0.0 },
+                ..sc.clone()
+            };
+            let s = w.simulate(&straight, 11).unwrap();
+            let sd = (s.y.iter().map(|x| x * x).sum::<f64>() / s.len() as f64).sqrt();
+            println!(
+                "{}: rms yaw rate on a straight course {sd:.4} °/s",
+                kind.name()
+            );
+            assert!(sd > 1e-3 && sd < 0.2, "{sd}");
+            // the default noise adds to it, on its own stream: the input is unchanged
+            let noisy = w
+                .simulate(
+                    &Scenario {
+                        noise: NoiseSpec::default(),
+                        ..sc.clone()
+                    },
+                    11,
+                )
+                .unwrap();
+            assert_eq!(noisy.u, a.u);
+            assert!(max_abs_diff(&noisy.y, &a.y) > 0.03);
+        }
+    }
+
+    #[test]
+    fn every_effect_changes_what_it_should() {
+        for kind in NEW {
+            let w = World::new(kind, None).unwrap();
+            let n = 900;
+            let base = w.simulate(&quiet(n, Vec::new(), &w), 7).unwrap();
+            for k in EffectKind::ALL {
+                let e = w.hidden(k, 1.0);
+                let rec = w.simulate(&quiet(n, vec![e], &w), 7).unwrap();
+                assert_eq!(rec.u, base.u, "{}: same command", k.name());
+                let dy = max_abs_diff(&rec.y, &base.y);
+                let dpsi = max_abs_diff(rec.psi.as_ref().unwrap(), base.psi.as_ref().unwrap());
+                let dv = max_abs_diff(rec.speed.as_ref().unwrap(), base.speed.as_ref().unwrap());
+                println!(
+                    "{} {}: {e:?}: Δr {dy:.4} °/s, Δψ {dpsi:.2}°, ΔU {dv:.4} m/s",
+                    kind.name(),
+                    k.name()
+                );
+                match e {
+                    SimEffect::GyroBias { bias_degps } => {
+                        // the rate shifts by the bias, heading and speed do not move
+                        let shift = mean(&rec.y) - mean(&base.y);
+                        assert!((shift - bias_degps).abs() < 1e-3, "{shift}");
+                        assert_eq!(dpsi, 0.0);
+                        assert_eq!(dv, 0.0);
+                    }
+                    SimEffect::Current { .. } => {
+                        // the ship is carried: its speed over ground changes by metres per
+                        // second, its turning hardly (only the air it feels changes)
+                        assert!(dv > 0.5, "{dv}");
+                    }
+                    _ => {
+                        assert!(dy > 0.005 || dpsi > 0.5, "{}: Δr {dy}, Δψ {dpsi}", k.name());
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn current_carries_the_ship_and_exerts_no_moment() {
+        for kind in NEW {
+            let w = World::new(kind, None).unwrap();
+            let h = w.hull().unwrap();
+            let cur = SimEffect::Current {
+                speed_mps: 1.5,
+                towards_deg: 90.0,
+            };
+            let (mut calm, _, _) = Physics::new(h.as_ref(), &[]);
+            let (mut carried, _, _) = Physics::new(h.as_ref(), &[cur]);
+            // without air, the current changes no acceleration and moves the ship by itself
+            calm.windage.a_l = 0.0;
+            calm.windage.a_f = 0.0;
+            carried.windage = calm.windage;
+            let s = [h.u0(), -0.3, 0.004, 0.0, 0.0, 30f64.to_radians()];
+            let a = calm.deriv(h.as_ref(), &s, 0.1, CALM);
+            let b = carried.deriv(h.as_ref(), &s, 0.1, CALM);
+            assert_eq!(a[..3], b[..3]);
+            assert!((b[3] - a[3]).abs() < 1e-12 && (b[4] - a[4] - 1.5).abs() < 1e-12);
+            // speed over ground: the water velocity plus the current
+            let sog = carried.sog(&s);
+            let (sp, cp) = s[5].sin_cos();
+            let (vn, ve) = (s[0] * cp - s[1] * sp, s[0] * sp + s[1] * cp + 1.5);
+            assert!((sog - vn.hypot(ve)).abs() < 1e-12);
+            // in a record at δ = 0 from 030°, the speed over ground is the speed through the
+            // water along the heading plus the current (1.5·cos 60° = 0.75 m/s along at
+            // first); the heading hardly changes with the current
+            let straight = Scenario {
+                input: InputSpec::Constant { delta_deg: 0.0 },
+                ..quiet(300, Vec::new(), &w)
+            };
+            let base = w.simulate(&straight, 3).unwrap();
+            let with = w
+                .simulate(
+                    &Scenario {
+                        effects: vec![cur],
+                        ..straight.clone()
+                    },
+                    3,
+                )
+                .unwrap();
+            let (psi, stw) = (base.psi.as_ref().unwrap(), base.speed.as_ref().unwrap());
+            let sog = with.speed.as_ref().unwrap();
+            let err = (0..base.len())
+                .map(|k| {
+                    let (sp, cp) = psi[k].to_radians().sin_cos();
+                    let expect = (stw[k] * cp).hypot(stw[k] * sp + 1.5);
+                    (sog[k] - expect).abs()
+                })
+                .fold(0.0, f64::max);
+            let gain = mean(sog) - mean(stw);
+            println!(
+                "{}: SOG − STW {gain:.3} m/s, worst error {err:.4}",
+                kind.name()
+            );
+            // (the error is the drift angle, left out of `expect`)
+            assert!(err < 0.08 && gain > 0.5, "{err} {gain}");
+            assert!(max_abs_diff(with.psi.as_ref().unwrap(), psi) < 2.0);
+        }
+    }
+
+    #[test]
+    fn wind_moment_follows_the_blendermann_curve() {
+        let w = World::new(WorldKind::Kvlcc2, None).unwrap();
+        let h = w.hull().unwrap();
+        let s = [h.u0(), 0.0, 0.0, 0.0, 0.0, 0.0];
+        let (calm, _, _) = Physics::new(h.as_ref(), &[]);
+        let rdot = |from_deg: f64| {
+            let wind = SimEffect::Wind {
+                speed_mps: 20.0,
+                from_deg,
+            };
+            let (p, _, _) = Physics::new(h.as_ref(), &[wind]);
+            let (ua, va) = p.air(&s, CALM);
+            let gamma = va.atan2(ua).to_degrees();
+            let dr =
+                p.deriv(h.as_ref(), &s, 0.0, CALM)[2] - calm.deriv(h.as_ref(), &s, 0.0, CALM)[2];
+            (gamma, dr)
+        };
+        // starboard bow: the bow falls off to port; starboard quarter: it turns into the
+        // wind; mirrored from port
+        let (g, d) = rdot(30.0);
+        assert!(g > 0.0 && g < 60.0 && d < 0.0, "{g} {d}");
+        let (g, d) = rdot(150.0);
+        assert!(g > 100.0 && d > 0.0, "{g} {d}");
+        let (g, d) = rdot(-30.0);
+        assert!(g < 0.0 && d > 0.0, "{g} {d}");
+        // in a record the gusts make the apparent wind speed vary by about their 10 %
+        let sc = Scenario {
+            log_wind: true,
+            input: InputSpec::Constant { delta_deg: 0.0 },
+            ..quiet(1200, vec![w.hidden(EffectKind::Wind, 1.0)], &w)
+        };
+        let rec = w.simulate(&sc, 5).unwrap();
+        let ws = rec.wind_speed.as_ref().unwrap();
+        let m = mean(ws);
+        let sd = (ws.iter().map(|x| (x - m).powi(2)).sum::<f64>() / ws.len() as f64).sqrt();
+        println!("apparent wind {m:.2} m/s ± {sd:.2}");
+        assert!(sd / m > 0.03 && sd / m < 0.2, "{m} {sd}");
+    }
+}

@@ -1,0 +1,145 @@
+//! CLI tests of `yawcast simulate --world`: the test worlds write the same CSV as the
+//! built-in ship, are seeded, and refuse the built-in ship's file options.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_yawcast"))
+        .args(args)
+        .output()
+        .expect("runs the binary")
+}
+
+/// A fresh scratch directory per test.
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("yawcast-worlds-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn simulate(dir: &std::path::Path, file: &str, extra: &[&str]) -> String {
+    let out = dir.join(file);
+    let path = out.to_str().unwrap().to_string();
+    let mut args = vec!["simulate", "--duration", "120", "--out", &path];
+    if !extra.contains(&"--seed") {
+        args.extend_from_slice(&["--seed", "5"]);
+    }
+    args.extend_from_slice(extra);
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    std::fs::read_to_string(&out).unwrap()
+}
+
+#[test]
+fn kvlcc2_writes_the_usual_columns_seeded() {
+    let d = scratch("kvlcc2");
+    let a = simulate(
+        &d,
+        "a.csv",
+        &["--world", "kvlcc2", "--effect", "wind", "--log-wind"],
+    );
+    let b = simulate(
+        &d,
+        "b.csv",
+        &["--world", "kvlcc2", "--effect", "wind", "--log-wind"],
+    );
+    assert_eq!(a, b, "same seed, same bytes");
+    let mut lines = a.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "t_s,delta_deg,r_degps,psi_deg,u_mps,wind_speed_mps,wind_angle_deg"
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    // 120 s at the default 1 s; a full-scale tanker at about 15.5 kn over ground
+    assert_eq!(rows.len(), 120);
+    assert_eq!(rows[1][0] - rows[0][0], 1.0);
+    assert!((7.0..9.0).contains(&rows[0][4]), "{:?}", rows[0]);
+    // a 14.7 m/s wind from 045° on a ship making 8 m/s
+    assert!((15.0..30.0).contains(&rows[0][5]), "{:?}", rows[0]);
+    let c = simulate(&d, "c.csv", &["--world", "kvlcc2", "--seed", "6"]);
+    assert_ne!(a.lines().nth(50), c.lines().nth(50));
+    // Froude-scaled to the 7 m model: Ts √(7/320) s, speed 1.18 m/s
+    let m = simulate(&d, "m.csv", &["--world", "kvlcc2", "--scale", "7"]);
+    let r: Vec<f64> = m
+        .lines()
+        .nth(2)
+        .unwrap()
+        .split(',')
+        .map(|x| x.parse().unwrap())
+        .collect();
+    assert!((r[0] - (7.0f64 / 320.0).sqrt()).abs() < 1e-6, "{r:?}");
+    assert!((1.0..1.4).contains(&r[4]), "{r:?}");
+    let js = d.join("s.json");
+    let mar = simulate(
+        &d,
+        "mar.csv",
+        &[
+            "--world",
+            "mariner",
+            "--input",
+            "zigzag:10/10",
+            "--json",
+            js.to_str().unwrap(),
+        ],
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&js).unwrap()).unwrap();
+    assert_eq!(summary["world"], "mariner");
+    assert_eq!(summary["ship"], "Mariner (Abkowitz, Lpp 160.93 m)");
+    assert_eq!(summary["records"][0]["samples"], 120);
+    assert!(mar.starts_with("t_s,delta_deg,r_degps,psi_deg,u_mps\n"));
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn the_lng_world_is_the_default() {
+    let d = scratch("lng");
+    let a = simulate(&d, "a.csv", &["--effect", "current", "--log-wind"]);
+    let b = simulate(
+        &d,
+        "b.csv",
+        &["--world", "lng", "--effect", "current", "--log-wind"],
+    );
+    assert_eq!(a, b);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn ship_files_and_scales_belong_to_their_worlds() {
+    let d = scratch("refuse");
+    let out = d.join("x.csv");
+    let out = out.to_str().unwrap();
+    let ship = d.join("s.toml");
+    std::fs::write(&ship, "").unwrap();
+    let o = run(&[
+        "simulate",
+        "--world",
+        "kvlcc2",
+        "--ship",
+        ship.to_str().unwrap(),
+        "--out",
+        out,
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(e.contains("--ship") && e.contains("--world lng"), "{e}");
+    let o = run(&[
+        "simulate", "--world", "mariner", "--scale", "7", "--out", out,
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--scale"), "{}", stderr(&o));
+    let o = run(&["simulate", "--world", "titanic", "--out", out]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(e.contains("lng, kvlcc2, mariner"), "{e}");
+    assert!(!std::path::Path::new(out).exists());
+    let _ = std::fs::remove_dir_all(&d);
+}
