@@ -498,16 +498,18 @@ fn grid(kind: EffectKind, ts: f64, u_max: f64, du_max: f64) -> Vec<Effect> {
 }
 
 /// The dead-band widths searched, by diagnose and by augment alike: 12 geometric steps from
-/// 2 % to 40 % of the largest command (0.4° to 8° for the usual ±20° trials; worn gears show
-/// 0.5–3°).
+/// 0.2° to 6° (worn steering gears show 0.5–3°), or to 40 % of the largest command when that
+/// is smaller. A wider "band" on large-amplitude records (zig-zags) only trades the command's
+/// amplitude against the model's gain, so it is not searched.
 ///
 /// ```
 /// let w = yawcast::diagnose::band_widths(20.0);
 /// assert_eq!(w.len(), 12);
-/// assert!((w[0] - 0.4).abs() < 1e-12 && (w[11] - 8.0).abs() < 1e-9);
+/// assert!((w[0] - 0.2).abs() < 1e-12 && (w[11] - 6.0).abs() < 1e-9);
+/// assert!((yawcast::diagnose::band_widths(5.0)[11] - 2.0).abs() < 1e-9);
 /// ```
 pub fn band_widths(u_max: f64) -> Vec<f64> {
-    geometric(0.02 * u_max, 0.4 * u_max, 12)
+    geometric(0.2, 6.0_f64.min(0.4 * u_max), 12)
 }
 
 fn geometric(lo: f64, hi: f64, n: usize) -> Vec<f64> {

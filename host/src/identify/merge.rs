@@ -172,7 +172,16 @@ fn sym_pinv(m: &DMatrix<f64>) -> (DMatrix<f64>, usize) {
         })
         .collect();
     let s = DMatrix::from_fn(n, n, |i, j| m[(i, j)] * d[i] * d[j]);
-    let e = s.symmetric_eigen();
+    // bounded iterations: a matrix the eigen-solver cannot take has rank 0 here (no
+    // information), not a hang
+    let Some(e) = s
+        .iter()
+        .all(|v| v.is_finite())
+        .then(|| s.try_symmetric_eigen(f64::EPSILON, 10_000))
+        .flatten()
+    else {
+        return (DMatrix::zeros(n, n), 0);
+    };
     let max = e.eigenvalues.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     let mut inv = DMatrix::zeros(n, n);
     let mut rank = 0;

@@ -639,12 +639,29 @@ pub fn from_difference_form(g: &[f64], b: &[f64], k: &[f64]) -> (Vec<f64>, Vec<f
     (a, sums(b), sums(k))
 }
 
-/// Largest eigenvalue modulus of a square matrix.
+/// Largest eigenvalue modulus of a square matrix; +∞ when an entry is not finite or the
+/// (bounded) Schur iteration does not converge, so such a matrix never counts as stable.
+///
+/// ```
+/// use nalgebra::DMatrix;
+/// use yawcast::identify::model::spectral_radius;
+/// let m = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -0.25, 0.0]);
+/// assert!((spectral_radius(&m) - 0.5).abs() < 1e-12);
+/// let bad = DMatrix::from_row_slice(2, 2, &[f64::NAN, 1.0, 3.4e200, 0.0]);
+/// assert_eq!(spectral_radius(&bad), f64::INFINITY);
+/// ```
 pub fn spectral_radius(m: &nalgebra::DMatrix<f64>) -> f64 {
-    m.complex_eigenvalues()
-        .iter()
-        .map(|z| z.norm())
-        .fold(0.0, f64::max)
+    if !m.iter().all(|v| v.is_finite()) {
+        return f64::INFINITY;
+    }
+    match m.clone().try_schur(f64::EPSILON, 10_000) {
+        Some(s) => s
+            .complex_eigenvalues()
+            .iter()
+            .map(|z| z.norm())
+            .fold(0.0, f64::max),
+        None => f64::INFINITY,
+    }
 }
 
 #[cfg(test)]

@@ -35,6 +35,70 @@ pub struct ZigzagResult {
     pub time_to_switch_s: f64,
 }
 
+/// Bookkeeping of a zig-zag's overshoots, shared by every simulator: fed each sample's
+/// heading change (deg) before the command logic sees it.
+#[derive(Debug)]
+pub(crate) struct ZigzagTracker {
+    psi_deg: f64,
+    switches: usize,
+    max1: f64,
+    min2: f64,
+    t_switch: f64,
+}
+
+impl ZigzagTracker {
+    pub(crate) fn new(psi_deg: f64) -> ZigzagTracker {
+        ZigzagTracker {
+            psi_deg,
+            switches: 0,
+            max1: f64::NEG_INFINITY,
+            min2: f64::INFINITY,
+            t_switch: f64::NAN,
+        }
+    }
+
+    /// Observes sample `k` (time `t` s) with heading change `dpsi`; `false` once the third
+    /// switch has come (the run may stop).
+    pub(crate) fn observe(&mut self, k: usize, t: f64, dpsi: f64) -> bool {
+        // the logic switches in `command`, called right after this observation
+        match self.switches {
+            1 => self.max1 = self.max1.max(dpsi),
+            2 => self.min2 = self.min2.min(dpsi),
+            _ => {}
+        }
+        let will_switch = match self.switches % 2 {
+            0 => dpsi >= self.psi_deg,
+            _ => dpsi <= -self.psi_deg,
+        };
+        if will_switch && k > 0 {
+            self.switches += 1;
+            if self.switches == 1 {
+                self.t_switch = t;
+                self.max1 = dpsi;
+            }
+            if self.switches == 2 {
+                self.min2 = dpsi;
+            }
+        }
+        self.switches < 3
+    }
+
+    /// The figures, or why there are none (`within` says how long the run was allowed).
+    pub(crate) fn result(&self, within: &str) -> Result<ZigzagResult, SimError> {
+        if self.switches < 3 {
+            return Err(SimError::Manoeuvre {
+                manoeuvre: "zig-zag",
+                reason: format!("only {} of 3 switches{within}", self.switches),
+            });
+        }
+        Ok(ZigzagResult {
+            first_overshoot_deg: self.max1 - self.psi_deg,
+            second_overshoot_deg: -self.min2 - self.psi_deg,
+            time_to_switch_s: self.t_switch,
+        })
+    }
+}
+
 fn settled(ship: &Ship) -> RunSpec<'_> {
     RunSpec {
         ship,
@@ -135,46 +199,11 @@ pub fn zigzag(ship: &Ship, delta_deg: f64, psi_deg: f64) -> Result<ZigzagResult,
     super::ship::within("psi_deg", psi_deg, 1e-3, 180.0)?;
     let spec = settled(ship);
     let mut logic = ZigZagLogic::new(delta_deg, psi_deg);
-    let (mut max1, mut min2) = (f64::NEG_INFINITY, f64::INFINITY);
-    let mut t_switch = f64::NAN;
-    let mut switches = 0;
+    let mut track = ZigzagTracker::new(psi_deg);
     run(
         &spec,
         |_, s| logic.command(s[5].to_degrees()),
-        |smp| {
-            let dpsi = smp.state[5].to_degrees();
-            // the logic switches in `command`, called right after this observation
-            match switches {
-                1 => max1 = max1.max(dpsi),
-                2 => min2 = min2.min(dpsi),
-                _ => {}
-            }
-            let will_switch = match switches % 2 {
-                0 => dpsi >= psi_deg,
-                _ => dpsi <= -psi_deg,
-            };
-            if will_switch && smp.k > 0 {
-                switches += 1;
-                if switches == 1 {
-                    t_switch = smp.k as f64 * TS;
-                    max1 = dpsi;
-                }
-                if switches == 2 {
-                    min2 = dpsi;
-                }
-            }
-            switches < 3
-        },
+        |smp| track.observe(smp.k, smp.k as f64 * TS, smp.state[5].to_degrees()),
     )?;
-    if switches < 3 {
-        return Err(SimError::Manoeuvre {
-            manoeuvre: "zig-zag",
-            reason: format!("only {switches} of 3 switches within {T_MAX} s"),
-        });
-    }
-    Ok(ZigzagResult {
-        first_overshoot_deg: max1 - psi_deg,
-        second_overshoot_deg: -min2 - psi_deg,
-        time_to_switch_s: t_switch,
-    })
+    track.result(&format!(" within {T_MAX} s"))
 }

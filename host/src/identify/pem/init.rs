@@ -46,7 +46,12 @@ pub(crate) fn spd_solve(h: &DMatrix<f64>, b: &DVector<f64>) -> Option<DVector<f6
     });
     let x = match x {
         Some(x) => x,
-        None => s.clone().svd(true, true).solve(&sb, 1e-12).ok()?,
+        // bounded iterations: a matrix the SVD cannot take gives no start, not a hang
+        None => s
+            .clone()
+            .try_svd(true, true, f64::EPSILON, 10_000)?
+            .solve(&sb, 1e-12)
+            .ok()?,
     };
     let out = DVector::from_iterator(n, (0..n).map(|i| x[i] * d[i]));
     out.iter().all(|v| v.is_finite()).then_some(out)
@@ -270,7 +275,10 @@ pub(crate) fn subspace(
     // O Oᵀ = L_w (W_p W_pᵀ) L_wᵀ, W_p the first 2i rows of Z
     let wp = zz.view((0, 0), (2 * i, 2 * i)).into_owned();
     let ooh = &lw * wp * lw.transpose();
-    let eig = ooh.symmetric_eigen();
+    if !ooh.iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let eig = ooh.try_symmetric_eigen(f64::EPSILON, 10_000)?;
     let mut order: Vec<usize> = (0..fr).collect();
     order.sort_by(|a, b| eig.eigenvalues[*b].total_cmp(&eig.eigenvalues[*a]));
     let top = &order[..n];
@@ -464,11 +472,15 @@ mod tests {
     }
 
     /// Windows that hold a missing y are left out, and so are the state pairs across the
-    /// gap: with 30 samples missing in the middle the start lands as near the truth.
+    /// gap: with 30 samples missing in the middle the start lands where the whole record's
+    /// start does (within 0.01 in every pole modulus), so as near the truth.
     #[test]
     fn subspace_start_skips_the_windows_of_a_gap() {
         let truth = super::super::testdata::truth();
-        let mut rec = super::super::testdata::record(3, 2000);
+        let whole = super::super::testdata::record(3, 2000);
+        let (a_whole, _, _) =
+            subspace(std::slice::from_ref(&whole), &[whole.u.clone()], 4).unwrap();
+        let mut rec = whole.clone();
         for v in &mut rec.y[985..1015] {
             *v = f64::NAN;
         }
@@ -485,9 +497,10 @@ mod tests {
             r.sort_by(f64::total_cmp);
             r
         };
-        let (pe, pt) = (moduli(&a), moduli(&truth.a));
-        for (x, y) in pe.iter().zip(&pt) {
-            assert!((x - y).abs() < 0.05, "{pe:?} vs {pt:?}");
+        let (pe, pw, pt) = (moduli(&a), moduli(&a_whole), moduli(&truth.a));
+        for ((x, w), y) in pe.iter().zip(&pw).zip(&pt) {
+            assert!((x - w).abs() < 0.01, "{pe:?} vs the whole record's {pw:?}");
+            assert!((x - y).abs() < 0.06, "{pe:?} vs {pt:?}");
         }
         let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
         let db: Vec<f64> = b.iter().zip(&truth.b).map(|(p, q)| p - q).collect();

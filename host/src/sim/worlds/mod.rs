@@ -53,6 +53,7 @@ use yawcast_shared::model::EffectKind;
 
 use super::dynamics::{self, Model};
 use super::inputs::{self, InputSpec, ZigZagLogic};
+use super::manoeuvres::ZigzagTracker;
 use super::{NoiseSpec, Scenario, Ship, SimEffect, SimError, TurningResult, ZigzagResult};
 use crate::io::data::Record;
 
@@ -858,47 +859,13 @@ fn zigzag_hull(hull: &dyn Hull, delta_deg: f64, psi_deg: f64) -> Result<ZigzagRe
     let spec = calm_run(hull, &p, act);
     let ts = spec.ts;
     let mut logic = ZigZagLogic::new(delta_deg, psi_deg);
-    let (mut max1, mut min2) = (f64::NEG_INFINITY, f64::INFINITY);
-    let mut t_switch = f64::NAN;
-    let mut switches = 0;
+    let mut track = ZigzagTracker::new(psi_deg);
     run_hull(
         spec,
         |_, s| logic.command(s[5].to_degrees()),
-        |k, s, _| {
-            let dpsi = s[5].to_degrees();
-            match switches {
-                1 => max1 = max1.max(dpsi),
-                2 => min2 = min2.min(dpsi),
-                _ => {}
-            }
-            let will_switch = match switches % 2 {
-                0 => dpsi >= psi_deg,
-                _ => dpsi <= -psi_deg,
-            };
-            if will_switch && k > 0 {
-                switches += 1;
-                if switches == 1 {
-                    t_switch = k as f64 * ts;
-                    max1 = dpsi;
-                }
-                if switches == 2 {
-                    min2 = dpsi;
-                }
-            }
-            switches < 3
-        },
+        |k, s, _| track.observe(k, k as f64 * ts, s[5].to_degrees()),
     )?;
-    if switches < 3 {
-        return Err(SimError::Manoeuvre {
-            manoeuvre: "zig-zag",
-            reason: format!("only {switches} of 3 switches"),
-        });
-    }
-    Ok(ZigzagResult {
-        first_overshoot_deg: max1 - psi_deg,
-        second_overshoot_deg: -min2 - psi_deg,
-        time_to_switch_s: t_switch,
-    })
+    track.result("")
 }
 
 #[cfg(test)]

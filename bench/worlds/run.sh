@@ -1,0 +1,131 @@
+#!/usr/bin/env bash
+# Cross-world diagnosis suite: how often `yawcast diagnose` names the hidden effect on every
+# simulator world (`simulate --world`), with an independent effect-free reference per world.
+#
+#   bench/worlds/run.sh [--yawcast PATH] [--work DIR] [--worlds LIST] [--seeds N]
+#                       [--strengths LIST] [--effects LIST] [--jobs J]
+#
+#   --yawcast PATH    the binary (default: build the ci profile and use it)
+#   --work DIR        records, models and diagnoses (default target/bench-worlds)
+#   --worlds LIST     comma-separated worlds (default lng,kvlcc2,mariner)
+#   --seeds N         seeds per case (default 3)
+#   --strengths LIST  comma-separated effect strengths (default 1,0.5)
+#   --effects LIST    comma-separated effects (default: none and every library effect)
+#   --jobs J          cases run at once (default 2)
+#
+# Per world: the reference is 3 records of the world's identification input (seeds 900–902,
+# gyro noise 0.02 °/s, heading noise 0.1°) and the model identified on them; each case is 3
+# trial records (seeds 100·s + 1…3, gyro noise 0.03 °/s, heading noise 0.2°, speed noise
+# 0.02 m/s) with the effect hidden at the given strength — other inputs and other noise than
+# the reference's. `diagnose --model … --reference … --data … --seed s --json` gives the
+# verdict. Prints per world and strength: right / cases, false alarms on effect-free trials,
+# and each effect's verdicts; the per-case verdicts are in DIR/cases.tsv.
+set -euo pipefail
+repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+
+yawcast=""
+work="$repo/target/bench-worlds"
+worlds="lng,kvlcc2,mariner"
+seeds=3
+strengths="1,0.5"
+effects="none,bias,gyro-bias,dead-time,rate-limit,saturation,asymmetry,nonlinear-damping,wind,current,dead-band"
+jobs=2
+while [ $# -gt 0 ]; do
+    case "$1" in
+        --yawcast) yawcast="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
+        --work) work="$2"; shift 2 ;;
+        --worlds) worlds="$2"; shift 2 ;;
+        --seeds) seeds="$2"; shift 2 ;;
+        --strengths) strengths="$2"; shift 2 ;;
+        --effects) effects="$2"; shift 2 ;;
+        --jobs) jobs="$2"; shift 2 ;;
+        -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
+        *) echo "unknown argument $1 (see --help)" >&2; exit 2 ;;
+    esac
+done
+if [ -z "$yawcast" ]; then
+    (cd "$repo" && cargo build -q --profile ci -p yawcast)
+    yawcast="${CARGO_TARGET_DIR:-$repo/target}/ci/yawcast"
+fi
+mkdir -p "$work"
+export YAWCAST="$yawcast" WORK="$work"
+
+# one case: world effect strength seed → a line "world<TAB>strength<TAB>effect<TAB>seed<TAB>verdict"
+case_run() {
+    local world="$1" effect="$2" strength="$3" seed="$4"
+    local dir="$WORK/$world/$effect-$strength-$seed"
+    mkdir -p "$dir"
+    local eff=()
+    [ "$effect" != none ] && eff=(--effect "$effect" --strength "$strength")
+    "$YAWCAST" simulate --world "$world" "${eff[@]}" --records 3 --seed $((100 * seed)) \
+        --gyro-noise 0.03 --heading-noise 0.2 --speed-noise 0.02 \
+        --out "$dir/trial.csv" >"$dir/simulate.log" 2>&1
+    local refs=()
+    for i in 1 2 3; do refs+=(--reference "$WORK/$world/ref-$i.csv"); done
+    local data=()
+    for i in 1 2 3; do data+=(--data "$dir/trial-$i.csv"); done
+    local verdict="error"
+    if "$YAWCAST" diagnose --model "$WORK/$world/ref.postcard" "${refs[@]}" "${data[@]}" \
+        --seed "$seed" --json "$dir/diagnosis.json" >"$dir/diagnose.log" 2>&1; then
+        verdict=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["verdict"])' \
+            "$dir/diagnosis.json")
+    fi
+    printf '%s\t%s\t%s\t%s\t%s\n' "$world" "$strength" "$effect" "$seed" "$verdict"
+}
+export -f case_run
+
+IFS=, read -r -a world_list <<<"$worlds"
+IFS=, read -r -a strength_list <<<"$strengths"
+IFS=, read -r -a effect_list <<<"$effects"
+start=$(date +%s)
+for w in "${world_list[@]}"; do
+    mkdir -p "$work/$w"
+    if [ ! -f "$work/$w/ref.postcard" ]; then
+        "$yawcast" simulate --world "$w" --records 3 --seed 900 --gyro-noise 0.02 \
+            --heading-noise 0.1 --out "$work/$w/ref.csv" >"$work/$w/ref.log" 2>&1
+        "$yawcast" identify --data "$work/$w/ref-1.csv" --data "$work/$w/ref-2.csv" \
+            --data "$work/$w/ref-3.csv" --out "$work/$w/ref" >>"$work/$w/ref.log" 2>&1
+    fi
+done
+list="$work/cases.list"
+: >"$list"
+for w in "${world_list[@]}"; do
+    for st in "${strength_list[@]}"; do
+        for e in "${effect_list[@]}"; do
+            # an effect-free case does not depend on the strength: run it once, at the first
+            if [ "$e" = none ] && [ "$st" != "${strength_list[0]}" ]; then continue; fi
+            for s in $(seq 1 "$seeds"); do echo "$w $e $st $s" >>"$list"; done
+        done
+    done
+done
+xargs -P "$jobs" -L 1 bash -c 'case_run "$@"' _ <"$list" | sort >"$work/cases.tsv"
+secs=$(( $(date +%s) - start ))
+
+python3 - "$work/cases.tsv" "$secs" "$(nproc)" <<'EOF'
+import collections, sys
+rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
+secs, cores = sys.argv[2], sys.argv[3]
+worlds = sorted({r[0] for r in rows}, key=["lng", "kvlcc2", "mariner"].index)
+print(f"# Cross-world diagnosis ({len(rows)} cases, {secs} s on {cores} cores)\n")
+print("| world | strength | effect cases right | false alarms (effect-free) | effects right in ≥ 2 of 3 seeds |")
+print("|---|---|---|---|---|")
+for w in worlds:
+    for st in sorted({r[1] for r in rows if r[0] == w}, key=float, reverse=True):
+        eff = [r for r in rows if r[0] == w and r[1] == st and r[2] != "none"]
+        right = sum(r[4] == r[2] for r in eff)
+        nulls = [r for r in rows if r[0] == w and r[2] == "none"]
+        alarms = sum(r[4] not in ("none",) for r in nulls)
+        by = collections.defaultdict(list)
+        for r in eff:
+            by[r[2]].append(r[4] == r[2])
+        good = sum(sum(v) * 3 >= 2 * len(v) for v in by.values())
+        print(f"| {w} | {st} | {right}/{len(eff)} | {alarms}/{len(nulls)} | {good}/{len(by)} |")
+print("\n## Verdicts per case (hidden → named)\n")
+for w in worlds:
+    for st in sorted({r[1] for r in rows if r[0] == w}, key=float, reverse=True):
+        line = []
+        for e in dict.fromkeys(r[2] for r in rows if r[0] == w and (r[1] == st or r[2] == "none")):
+            vs = [r[4] for r in rows if r[0] == w and r[2] == e and (r[1] == st or e == "none")]
+            line.append(f"{e}: " + " ".join("✓" if v == e else v for v in vs))
+        print(f"- {w}, strength {st}: " + "; ".join(line))
+EOF
