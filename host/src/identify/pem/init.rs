@@ -478,8 +478,12 @@ mod tests {
     fn subspace_start_skips_the_windows_of_a_gap() {
         let truth = super::super::testdata::truth();
         let whole = super::super::testdata::record(3, 2000);
-        let (a_whole, _, _) =
-            subspace(std::slice::from_ref(&whole), &[whole.u.clone()], 4).unwrap();
+        let (a_whole, _, _) = subspace(
+            std::slice::from_ref(&whole),
+            std::slice::from_ref(&whole.u),
+            4,
+        )
+        .unwrap();
         let mut rec = whole.clone();
         for v in &mut rec.y[985..1015] {
             *v = f64::NAN;
