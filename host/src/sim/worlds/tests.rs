@@ -1,0 +1,270 @@
+//! Tests of the test worlds: manoeuvres against published trials, every effect's physics,
+//! the shared environment and seeding.
+use super::*;
+
+fn quiet(n: usize, effects: Vec<SimEffect>, w: &World) -> Scenario {
+    Scenario {
+        noise: NoiseSpec::none(),
+        initial_heading_deg: Some(30.0),
+        n_samples: n,
+        input: w.default_input(),
+        effects,
+        ..Scenario::default()
+    }
+}
+
+fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
+fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len() as f64
+}
+
+const NEW: [WorldKind; 2] = [WorldKind::Kvlcc2, WorldKind::Mariner];
+
+#[test]
+fn the_lng_world_is_the_built_in_simulator() {
+    let w = World::new(WorldKind::Lng, None).unwrap();
+    let sc = Scenario {
+        n_samples: 300,
+        effects: vec![SimEffect::hidden(EffectKind::Wind, 1.0)],
+        log_wind: true,
+        ..Scenario::default()
+    };
+    let a = w.simulate(&sc, 4).unwrap();
+    assert_eq!(
+        a,
+        super::super::simulate(&Ship::default_lng(), &sc, 4).unwrap()
+    );
+    for k in EffectKind::ALL {
+        assert_eq!(w.hidden(k, 0.7), SimEffect::hidden(k, 0.7));
+    }
+    assert_eq!(w.default_ts(), 1.0);
+    assert_eq!(w.name(), Ship::default_lng().name);
+}
+
+#[test]
+fn canonical_strengths_carry_over_by_the_hull_time() {
+    let (l, _, _, u) = lng_reference();
+    for kind in NEW {
+        let w = World::new(kind, None).unwrap();
+        let t = w.time_ratio();
+        let h = w.hull().unwrap();
+        assert!((t - (h.lpp() / h.u0()) / (l / u)).abs() < 1e-12);
+        println!(
+            "{}: L/U = {:.1} s, {t:.2} × the built-in ship's",
+            kind.name(),
+            h.lpp() / h.u0()
+        );
+        assert_eq!(
+            w.hidden(EffectKind::DeadTime, 1.0),
+            SimEffect::DeadTime { delay_s: 2.0 * t }
+        );
+        assert_eq!(
+            w.hidden(EffectKind::Saturation, 1.0),
+            SimEffect::Saturation { limit_deg: 8.0 }
+        );
+        for k in EffectKind::ALL {
+            w.hidden(k, 1.0).validate("x").unwrap();
+        }
+        let InputSpec::Prbs {
+            min_hold_s,
+            max_hold_s,
+            ..
+        } = w.default_input()
+        else {
+            panic!()
+        };
+        assert_eq!(
+            (min_hold_s, max_hold_s),
+            ((5.0 * t).round(), (30.0 * t).round())
+        );
+    }
+    // a scaled KVLCC2 keeps full-scale wind in Froude proportion
+    let m = World::new(WorldKind::Kvlcc2, Some(7.0)).unwrap();
+    let SimEffect::Wind { speed_mps, .. } = m.hidden(EffectKind::Wind, 1.0) else {
+        panic!()
+    };
+    assert!((speed_mps - 3.0 * 24f64.sqrt() * (7.0f64 / 320.0).sqrt()).abs() < 1e-12);
+}
+
+#[test]
+fn the_seed_fixes_the_record_and_the_background_is_always_there() {
+    for kind in NEW {
+        let w = World::new(kind, None).unwrap();
+        let sc = quiet(400, Vec::new(), &w);
+        let a = w.simulate(&sc, 11).unwrap();
+        assert_eq!(a, w.simulate(&sc, 11).unwrap());
+        let b = w.simulate(&sc, 12).unwrap();
+        assert_ne!(a.u, b.u);
+        // on a straight course (δ = 0) the background yaw disturbance and the sensors
+        // still move the yaw rate
+        let straight = Scenario {
+            input: InputSpec::Constant { delta_deg: 0.0 },
+            ..sc.clone()
+        };
+        let s = w.simulate(&straight, 11).unwrap();
+        let sd = (s.y.iter().map(|x| x * x).sum::<f64>() / s.len() as f64).sqrt();
+        println!(
+            "{}: rms yaw rate on a straight course {sd:.4} °/s",
+            kind.name()
+        );
+        assert!(sd > 1e-3 && sd < 0.2, "{sd}");
+        // the default noise adds to it, on its own stream: the input is unchanged
+        let noisy = w
+            .simulate(
+                &Scenario {
+                    noise: NoiseSpec::default(),
+                    ..sc.clone()
+                },
+                11,
+            )
+            .unwrap();
+        assert_eq!(noisy.u, a.u);
+        assert!(max_abs_diff(&noisy.y, &a.y) > 0.03);
+    }
+}
+
+#[test]
+fn every_effect_changes_what_it_should() {
+    for kind in NEW {
+        let w = World::new(kind, None).unwrap();
+        let n = 900;
+        let base = w.simulate(&quiet(n, Vec::new(), &w), 7).unwrap();
+        for k in EffectKind::ALL {
+            let e = w.hidden(k, 1.0);
+            let rec = w.simulate(&quiet(n, vec![e], &w), 7).unwrap();
+            assert_eq!(rec.u, base.u, "{}: same command", k.name());
+            let dy = max_abs_diff(&rec.y, &base.y);
+            let dpsi = max_abs_diff(rec.psi.as_ref().unwrap(), base.psi.as_ref().unwrap());
+            let dv = max_abs_diff(rec.speed.as_ref().unwrap(), base.speed.as_ref().unwrap());
+            println!(
+                "{} {}: {e:?}: Δr {dy:.4} °/s, Δψ {dpsi:.2}°, ΔU {dv:.4} m/s",
+                kind.name(),
+                k.name()
+            );
+            match e {
+                SimEffect::GyroBias { bias_degps } => {
+                    // the rate shifts by the bias, heading and speed do not move
+                    let shift = mean(&rec.y) - mean(&base.y);
+                    assert!((shift - bias_degps).abs() < 1e-3, "{shift}");
+                    assert_eq!(dpsi, 0.0);
+                    assert_eq!(dv, 0.0);
+                }
+                SimEffect::Current { .. } => {
+                    // the ship is carried: its speed over ground changes by metres per
+                    // second, its turning hardly (only the air it feels changes)
+                    assert!(dv > 0.5, "{dv}");
+                }
+                _ => {
+                    assert!(dy > 0.005 || dpsi > 0.5, "{}: Δr {dy}, Δψ {dpsi}", k.name());
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn current_carries_the_ship_and_exerts_no_moment() {
+    for kind in NEW {
+        let w = World::new(kind, None).unwrap();
+        let h = w.hull().unwrap();
+        let cur = SimEffect::Current {
+            speed_mps: 1.5,
+            towards_deg: 90.0,
+        };
+        let (mut calm, _, _) = Physics::new(h.as_ref(), &[]);
+        let (mut carried, _, _) = Physics::new(h.as_ref(), &[cur]);
+        // without air, the current changes no acceleration and moves the ship by itself
+        calm.windage.a_l = 0.0;
+        calm.windage.a_f = 0.0;
+        carried.windage = calm.windage;
+        let s = [h.u0(), -0.3, 0.004, 0.0, 0.0, 30f64.to_radians()];
+        let a = calm.deriv(h.as_ref(), &s, 0.1, CALM);
+        let b = carried.deriv(h.as_ref(), &s, 0.1, CALM);
+        assert_eq!(a[..3], b[..3]);
+        assert!((b[3] - a[3]).abs() < 1e-12 && (b[4] - a[4] - 1.5).abs() < 1e-12);
+        // speed over ground: the water velocity plus the current
+        let sog = carried.sog(&s);
+        let (sp, cp) = s[5].sin_cos();
+        let (vn, ve) = (s[0] * cp - s[1] * sp, s[0] * sp + s[1] * cp + 1.5);
+        assert!((sog - vn.hypot(ve)).abs() < 1e-12);
+        // in a record at δ = 0 from 030°, the speed over ground is the speed through the
+        // water along the heading plus the current (1.5·cos 60° = 0.75 m/s along at
+        // first); the heading hardly changes with the current
+        let straight = Scenario {
+            input: InputSpec::Constant { delta_deg: 0.0 },
+            ..quiet(300, Vec::new(), &w)
+        };
+        let base = w.simulate(&straight, 3).unwrap();
+        let with = w
+            .simulate(
+                &Scenario {
+                    effects: vec![cur],
+                    ..straight.clone()
+                },
+                3,
+            )
+            .unwrap();
+        let (psi, stw) = (base.psi.as_ref().unwrap(), base.speed.as_ref().unwrap());
+        let sog = with.speed.as_ref().unwrap();
+        let err = (0..base.len())
+            .map(|k| {
+                let (sp, cp) = psi[k].to_radians().sin_cos();
+                let expect = (stw[k] * cp).hypot(stw[k] * sp + 1.5);
+                (sog[k] - expect).abs()
+            })
+            .fold(0.0, f64::max);
+        let gain = mean(sog) - mean(stw);
+        println!(
+            "{}: SOG − STW {gain:.3} m/s, worst error {err:.4}",
+            kind.name()
+        );
+        // (the error is the drift angle, left out of `expect`)
+        assert!(err < 0.08 && gain > 0.5, "{err} {gain}");
+        assert!(max_abs_diff(with.psi.as_ref().unwrap(), psi) < 2.0);
+    }
+}
+
+#[test]
+fn wind_moment_follows_the_blendermann_curve() {
+    let w = World::new(WorldKind::Kvlcc2, None).unwrap();
+    let h = w.hull().unwrap();
+    let s = [h.u0(), 0.0, 0.0, 0.0, 0.0, 0.0];
+    let (calm, _, _) = Physics::new(h.as_ref(), &[]);
+    let rdot = |from_deg: f64| {
+        let wind = SimEffect::Wind {
+            speed_mps: 20.0,
+            from_deg,
+        };
+        let (p, _, _) = Physics::new(h.as_ref(), &[wind]);
+        let (ua, va) = p.air(&s, CALM);
+        let gamma = va.atan2(ua).to_degrees();
+        let dr = p.deriv(h.as_ref(), &s, 0.0, CALM)[2] - calm.deriv(h.as_ref(), &s, 0.0, CALM)[2];
+        (gamma, dr)
+    };
+    // starboard bow: the bow falls off to port; starboard quarter: it turns into the
+    // wind; mirrored from port
+    let (g, d) = rdot(30.0);
+    assert!(g > 0.0 && g < 60.0 && d < 0.0, "{g} {d}");
+    let (g, d) = rdot(150.0);
+    assert!(g > 100.0 && d > 0.0, "{g} {d}");
+    let (g, d) = rdot(-30.0);
+    assert!(g < 0.0 && d > 0.0, "{g} {d}");
+    // in a record the gusts make the apparent wind speed vary by about their 10 %
+    let sc = Scenario {
+        log_wind: true,
+        input: InputSpec::Constant { delta_deg: 0.0 },
+        ..quiet(1200, vec![w.hidden(EffectKind::Wind, 1.0)], &w)
+    };
+    let rec = w.simulate(&sc, 5).unwrap();
+    let ws = rec.wind_speed.as_ref().unwrap();
+    let m = mean(ws);
+    let sd = (ws.iter().map(|x| (x - m).powi(2)).sum::<f64>() / ws.len() as f64).sqrt();
+    println!("apparent wind {m:.2} m/s ± {sd:.2}");
+    assert!(sd / m > 0.03 && sd / m < 0.2, "{m} {sd}");
+}
