@@ -284,7 +284,7 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
         .first()
         .or(est.first())
         .context("no record to check the export on")?;
-    let ex = add_export(&mut outputs, written, &args.out, check)?;
+    let ex = super::pipeline::add_model(&mut outputs, written, &args.out, check)?;
     let mut done = vec![format!(
         "model written to {} and {}{}",
         ex.blob_path.display(),
@@ -353,20 +353,6 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
     Ok(())
 }
 
-/// Adds the export of `model` (`<out>.postcard` and `<out>.json`, checked through the
-/// firmware on `check`) to `outputs`.
-fn add_export(
-    outputs: &mut Outputs,
-    model: &Model,
-    out: &Path,
-    check: &Record,
-) -> Result<export::ExportReport> {
-    let (report, files) = export::prepare_with(model, out, check, &export::ExportConfig::default())
-        .with_context(|| format!("exporting the model {}", out.display()))?;
-    outputs.extend(files);
-    Ok(report)
-}
-
 /// The `--more` search from `model` (`None` without `--more`), printed.
 fn search_more(
     args: &AugmentArgs,
@@ -415,7 +401,7 @@ fn write_unchanged(
         .first()
         .or(est.first())
         .context("no record to check the export on")?;
-    let ex = add_export(&mut outputs, written, &args.out, check)?;
+    let ex = super::pipeline::add_model(&mut outputs, written, &args.out, check)?;
     let mut done = vec![if what == Written::Input {
         format!(
             "no effect to add: the input model is written unchanged to {}",

@@ -33,8 +33,8 @@ fn names(paths: &[PathBuf]) -> String {
 }
 
 /// Adds `model` as `<out>.postcard` + `<out>.json` to `outputs`, checked through the firmware
-/// on `check`.
-fn add_model(
+/// on `check` (also `augment`'s).
+pub(super) fn add_model(
     outputs: &mut Outputs,
     model: &Model,
     out: &Path,
