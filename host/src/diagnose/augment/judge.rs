@@ -1,0 +1,341 @@
+//! The held-out judgement (steps 3 and 4): the hold-out split, the evaluation per horizon,
+//! the paired gain and its t test, the keep/decline rule and the model written when the
+//! effect is declined.
+
+use std::collections::BTreeMap;
+
+use yawcast_shared::model::EffectKind;
+
+use super::refit::reidentify_warm;
+use super::{AugmentConfig, Prepared, Written};
+use crate::diagnose::compare::InputError;
+use crate::diagnose::resid;
+use crate::identify::model::Model;
+use crate::identify::pem::PemReport;
+use crate::identify::predict::{self, Horizon};
+use crate::io::data::Record;
+
+/// ΔBIC at or below which the estimation evidence for an effect counts as decisive ("very
+/// strong", Kass and Raftery 1995): the effect is then kept when it predicts no worse.
+pub(super) const DECISIVE_BIC: f64 = -10.0;
+
+/// Held-out evaluation of one model.
+pub(super) struct Eval {
+    pub(super) mean: BTreeMap<String, f64>,
+    pub(super) units10: Vec<f64>,
+    pub(super) units_sim: Vec<f64>,
+    pub(super) resid: Vec<Vec<f64>>,
+    pub(super) finite: bool,
+}
+
+/// Splits the estimation records into estimation and held-out parts.
+pub(super) fn holdout(
+    est: &[Record],
+    n: usize,
+) -> Result<(Vec<Record>, Vec<Record>, String), InputError> {
+    let min_part = (12 * n + 12).max(100);
+    if est.iter().all(|r| r.len() / 3 >= min_part) {
+        let mut e = Vec::new();
+        let mut v = Vec::new();
+        for r in est {
+            let cut = r.len() - r.len() / 3;
+            let mut a = r.slice(0, cut);
+            let mut b = r.slice(cut, r.len());
+            a.name = format!("{} (first two thirds)", r.name);
+            b.name = format!("{} (last third)", r.name);
+            e.push(a);
+            v.push(b);
+        }
+        return Ok((
+            e,
+            v,
+            "no validation records given: the last third of each estimation record was held out"
+                .into(),
+        ));
+    }
+    if est.len() >= 3 {
+        let k = est.len().div_ceil(3);
+        let split = est.len() - k;
+        return Ok((
+            est[..split].to_vec(),
+            est[split..].to_vec(),
+            format!(
+                "no validation records given: the last {k} of {} estimation records were held out",
+                est.len()
+            ),
+        ));
+    }
+    let short = est
+        .iter()
+        .min_by_key(|r| r.len())
+        .map(|r| (r.name.clone(), r.len()))
+        .unwrap_or_default();
+    Err(InputError::TooShort {
+        record: short.0,
+        found: short.1,
+        needed: 3 * min_part,
+        why: "holding out its last third for validation (no validation records given; \
+              give --validate records or at least three estimation records)"
+            .into(),
+    })
+}
+
+/// Units the paired held-out gain is computed on, at least.
+const MIN_UNITS: usize = 12;
+
+/// Number of blocks each held-out record is cut into so that the spread of the gain is
+/// estimated from at least [`MIN_UNITS`] units.
+fn blocks_per_record(records: usize) -> usize {
+    MIN_UNITS.div_ceil(records.max(1))
+}
+
+pub(super) fn evaluate(
+    model: &Model,
+    val: &[Record],
+    horizons: &[Horizon],
+    parallel: bool,
+) -> Eval {
+    let nb = blocks_per_record(val.len());
+    let one = |rec: &Record| {
+        let x0 = predict::estimate_x0(model, rec);
+        let mut fits = BTreeMap::new();
+        let mut u10 = Vec::new();
+        let mut usim = Vec::new();
+        let mut res = Vec::new();
+        for h in horizons {
+            let yhat = predict::predict(model, rec, &x0, *h);
+            fits.insert(h.key(), predict::fit(&rec.y, &yhat));
+            let len = rec.len();
+            let blocks: Vec<f64> = (0..nb)
+                .map(|b| {
+                    let (s, e) = (b * len / nb, (b + 1) * len / nb);
+                    predict::fit(&rec.y[s..e], &yhat[s..e])
+                })
+                .collect();
+            match h {
+                Horizon::Steps(10) => u10 = blocks,
+                Horizon::Sim => usim = blocks,
+                Horizon::Steps(1) => {
+                    res = rec.y.iter().zip(&yhat).map(|(a, b)| a - b).collect();
+                }
+                _ => {}
+            }
+        }
+        (fits, u10, usim, res)
+    };
+    let per: Vec<_> = crate::par::map(val, parallel, one);
+    let keys: Vec<String> = horizons.iter().map(Horizon::key).collect();
+    let mean = crate::diagnose::compare::mean_fits(per.iter().map(|p| &p.0), &keys);
+    let finite = mean.values().all(|v| v.is_finite());
+    let mut e = Eval {
+        mean,
+        units10: Vec::new(),
+        units_sim: Vec::new(),
+        resid: Vec::new(),
+        finite,
+    };
+    for (_, a, b, r) in per {
+        e.units10.extend(a);
+        e.units_sim.extend(b);
+        e.resid.push(r);
+    }
+    e
+}
+
+/// One-sided 95 % Student t quantile for `dof` degrees of freedom (+∞ for none).
+fn t_crit(dof: usize) -> f64 {
+    crate::stats::student_t_quantile(0.05, dof as f64)
+}
+
+/// Paired gain statistics: (mean, standard error, t).
+fn paired(after: &[f64], base: &[f64]) -> (f64, f64, f64) {
+    let g: Vec<f64> = after.iter().zip(base).map(|(a, b)| a - b).collect();
+    let k = g.len();
+    if k == 0 || g.iter().any(|v| !v.is_finite()) {
+        return (f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+    }
+    let m = g.iter().sum::<f64>() / k as f64;
+    if k < 2 {
+        return (m, f64::INFINITY, 0.0);
+    }
+    let var = g.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (k - 1) as f64;
+    let se = (var / k as f64).sqrt();
+    let t = if se > 0.0 {
+        m / se
+    } else if m > 0.0 {
+        f64::INFINITY
+    } else if m < 0.0 {
+        f64::NEG_INFINITY
+    } else {
+        0.0
+    };
+    (m, se, t)
+}
+
+pub(super) fn ljung_box_p(resid: &[Vec<f64>]) -> f64 {
+    let n: usize = resid.iter().map(Vec::len).sum();
+    if resid.iter().flatten().any(|v| !v.is_finite()) || n < 30 {
+        return f64::NAN;
+    }
+    let acf = resid::acf(resid, 25);
+    resid::ljung_box(&acf, n, 25).1
+}
+
+/// Whether the model survives the f32 export schema and comes back with the same structure.
+pub(super) fn round_trips(m: &Model) -> bool {
+    let Ok(spec) = m.to_spec() else {
+        return false;
+    };
+    let Ok(back) = Model::from_spec(&spec) else {
+        return false;
+    };
+    back.effects.len() == m.effects.len()
+        && back
+            .effects
+            .iter()
+            .zip(&m.effects)
+            .all(|(a, b)| a.kind() == b.kind())
+        && back.is_stable()
+}
+
+/// The model to keep when no effect is added: the baseline (the input structure
+/// re-identified on the estimation part, then on the whole estimation records when a part
+/// was held out) when it validates better than the input model at 10 steps and no worse in
+/// simulation on the held-out records, else the input model; with a sentence saying so.
+pub(super) fn without_effect(
+    model: &Model,
+    est: &[Record],
+    prep: &Prepared,
+    cfg: &AugmentConfig,
+) -> (Model, Written, Option<String>) {
+    let get = |e: &Eval, k: &str| e.mean.get(k).copied().unwrap_or(f64::NAN);
+    let (b10, bsim) = (get(&prep.baseline, "10"), get(&prep.baseline, "sim"));
+    let (i10, isim) = (get(&prep.before, "10"), get(&prep.before, "sim"));
+    if !(b10 > i10 && bsim >= isim) {
+        return (model.clone(), Written::Input, None);
+    }
+    let mut refit = prep.base.model.clone();
+    if prep.held_note.is_some() {
+        if let Ok(full) = reidentify_warm(est, &refit, cfg) {
+            if full.model.is_stable() && round_trips(&full.model) {
+                refit = full.model;
+            }
+        }
+    }
+    if !(refit.is_stable() && round_trips(&refit)) {
+        return (model.clone(), Written::Input, None);
+    }
+    let note = format!(
+        "The model written is the input structure re-identified on the estimation records: \
+         it validates better than the input model on the held-out records (10 steps {i10:.2} \
+         → {b10:.2} %, simulation {isim:.2} → {bsim:.2} %)."
+    );
+    (refit, Written::Refit, Some(note))
+}
+
+/// What step 4 weighs for one candidate against the baseline.
+pub(super) struct Judgement {
+    pub(super) delta_aic: f64,
+    pub(super) delta_bic: f64,
+    pub(super) g10: f64,
+    pub(super) se10: f64,
+    pub(super) gsim: f64,
+    pub(super) sesim: f64,
+    /// The held-out gain is significant at 10 steps or in simulation.
+    pub(super) sig: bool,
+    pub(super) stable: bool,
+    /// Why the candidate is not kept; empty when it is.
+    pub(super) reasons: Vec<String>,
+    /// Whether it is kept (no reason against it).
+    pub(super) kept: bool,
+}
+
+/// Step 4's rule for a candidate identified on the estimation records and evaluated on
+/// the held-out ones (`after`): ΔAIC and ΔBIC against the baseline, the paired held-out
+/// gains, and the reasons not to keep it.
+pub(super) fn judge(
+    kind: EffectKind,
+    cand: &PemReport,
+    base: &PemReport,
+    before: &Eval,
+    baseline: &Eval,
+    after: &Eval,
+) -> Judgement {
+    let extra = if kind.is_actuator() { 1.0 } else { 0.0 };
+    let nf = cand.samples as f64;
+    let delta_aic = cand.aic + 2.0 * extra - base.aic;
+    let delta_bic = cand.bic + extra * nf.ln() - base.bic;
+
+    let (g10, se10, t10) = paired(&after.units10, &baseline.units10);
+    let (gsim, sesim, tsim) = paired(&after.units_sim, &baseline.units_sim);
+    let tc = t_crit(after.units10.len().saturating_sub(1));
+    let get = |e: &Eval, k: &str| e.mean.get(k).copied().unwrap_or(f64::NAN);
+    let stable = cand.model.is_stable();
+    let exports = round_trips(&cand.model);
+    let mut reasons: Vec<String> = Vec::new();
+    if !after.finite {
+        reasons.push("its held-out predictions go non-finite".into());
+    }
+    if !stable {
+        reasons.push("it is unstable".into());
+    }
+    if stable && !exports {
+        let (ra, rp) = cand.model.spectral_radii();
+        reasons.push(format!(
+            "rounded to f32 for the firmware it is no longer a valid stable model (spectral \
+             radii {ra:.7} and {rp:.7}: a pole on the unit circle, typically following an \
+             offset the model has no effect for)"
+        ));
+    }
+    if delta_bic.is_nan() || delta_bic >= 0.0 {
+        reasons.push(format!(
+            "ΔBIC = {delta_bic:+.1} ≥ 0 on the estimation records: the extra parameter does not pay for itself"
+        ));
+    }
+    let sig = t10 > tc || tsim > tc;
+    // decisive estimation evidence (ΔBIC ≤ −10, "very strong" on Kass and Raftery's scale)
+    // with held-out prediction no worse: the effect explains with physics what the
+    // re-identified structure otherwise absorbs into θ (a delay into extra poles), so the
+    // physical model is kept — it predicts as well and can go into the simulator
+    let decisive = delta_bic <= DECISIVE_BIC && t10 >= -tc && tsim >= -tc;
+    let worse = t10 < -tc || tsim < -tc;
+    if !sig && !decisive && !worse {
+        reasons.push(format!(
+            "the held-out gain over the re-identified model ({g10:+.2} ± {se10:.2} pp at 10 steps, \
+             {gsim:+.2} ± {sesim:.2} pp in simulation) is within the record-to-record spread"
+        ));
+    }
+    if worse {
+        reasons.push(format!(
+            "it predicts significantly worse than the re-identified model ({g10:+.2} ± \
+             {se10:.2} pp at 10 steps, {gsim:+.2} ± {sesim:.2} pp in simulation)"
+        ));
+    }
+    for k in ["10", "sim"] {
+        if get(after, k) < get(before, k) {
+            reasons.push(format!(
+                "it would validate worse than the input model at {} ({:.1} < {:.1} %)",
+                if k == "sim" {
+                    "simulation".to_string()
+                } else {
+                    format!("{k} steps")
+                },
+                get(after, k),
+                get(before, k)
+            ));
+        }
+    }
+    let kept = reasons.is_empty();
+    Judgement {
+        delta_aic,
+        delta_bic,
+        g10,
+        se10,
+        gsim,
+        sesim,
+        sig,
+        stable,
+        reasons,
+        kept,
+    }
+}
