@@ -1,0 +1,428 @@
+//! The frozen-θ likelihood statistics: prediction errors and their sensitivities to an
+//! effect's gains, each effect's parameter grid, the version of an effect a record set
+//! shows, and the statistic `D` of every kind in one world.
+
+use nalgebra::{DMatrix, DVector};
+use yawcast_shared::model::EffectKind;
+
+use super::SLOW_HORIZON;
+use crate::identify::model::{Effect, Model};
+use crate::identify::predict::{self, Stepper};
+use crate::io::data::Record;
+
+/// Every `SLOW_STRIDE`-th sample's 50-step error is used (they overlap heavily anyway).
+const SLOW_STRIDE: usize = 10;
+
+pub(super) fn horizon_of(kind: EffectKind) -> usize {
+    match kind {
+        EffectKind::Bias | EffectKind::GyroBias | EffectKind::Wind | EffectKind::Current => {
+            SLOW_HORIZON
+        }
+        EffectKind::DeadTime
+        | EffectKind::RateLimit
+        | EffectKind::Saturation
+        | EffectKind::DeadBand
+        | EffectKind::Asymmetry
+        | EffectKind::NonlinearDamping => 1,
+    }
+}
+
+/// Prediction errors `y − ŷ` at horizon `h` (all samples for h = 1; every
+/// [`SLOW_STRIDE`]-th sample from `h` on otherwise). Open-loop steps use the measured heading.
+fn errors(model: &Model, rec: &Record, x0: &[f64], h: usize) -> Vec<f64> {
+    let s = Stepper::new(model);
+    let psi = |t: usize| rec.psi.as_ref().map(|p| p[t]);
+    let p0 = psi(0).unwrap_or(0.0);
+    let mut st = s.initial(x0, p0);
+    let n = rec.len();
+    if h <= 1 {
+        return (0..n)
+            .map(|t| rec.y[t] - s.step(&mut st, rec.u[t], rec.y[t], psi(t)).yhat)
+            .collect();
+    }
+    // the open-loop pass predicting sample t starts from the filter's state at t + 1 − h: it
+    // runs as the filter passes there, so no state sequence is kept
+    let mut out = Vec::with_capacity(n / SLOW_STRIDE + 1);
+    let mut w = st.clone();
+    let mut t = h;
+    for start in 0..n {
+        if t < n && start == t + 1 - h {
+            w.clone_from(&st);
+            for j in start..t {
+                s.step(&mut w, rec.u[j], f64::NAN, psi(j));
+            }
+            out.push(rec.y[t] - s.output(&w));
+            t += SLOW_STRIDE;
+        }
+        s.step(&mut st, rec.u[start], rec.y[start], psi(start));
+    }
+    out
+}
+
+/// Least-squares pieces of one candidate on a set of records: `e₀ᵀe₀`, `Sᵀe₀`, `SᵀS` with
+/// `S` the sensitivities of ŷ to the effect's gains (so `SSE(β) = ‖e₀ − Sβ‖²`).
+#[derive(Debug, Clone)]
+pub(super) struct Quad {
+    ee: f64,
+    se: DVector<f64>,
+    ss: DMatrix<f64>,
+    n: usize,
+}
+
+impl Quad {
+    fn zero(p: usize) -> Quad {
+        Quad {
+            ee: 0.0,
+            se: DVector::zeros(p),
+            ss: DMatrix::zeros(p, p),
+            n: 0,
+        }
+    }
+
+    fn add(&mut self, o: &Quad) {
+        self.ee += o.ee;
+        self.se += &o.se;
+        self.ss += &o.ss;
+        self.n += o.n;
+    }
+
+    fn sse(&self, beta: &DVector<f64>) -> f64 {
+        if beta.is_empty() {
+            return self.ee;
+        }
+        (self.ee - 2.0 * beta.dot(&self.se) + beta.dot(&(&self.ss * beta))).max(1e-300)
+    }
+
+    pub(super) fn best(&self) -> (DVector<f64>, f64) {
+        let p = self.se.len();
+        if p == 0 {
+            return (DVector::zeros(0), self.ee.max(1e-300));
+        }
+        let mut a = self.ss.clone();
+        let ridge = 1e-10 * (a.trace() / p as f64).max(1e-300);
+        for i in 0..p {
+            a[(i, i)] += ridge;
+        }
+        let beta = a
+            .cholesky()
+            .map(|c| c.solve(&self.se))
+            .unwrap_or_else(|| DVector::zeros(p));
+        let s = self.sse(&beta);
+        (beta, s)
+    }
+}
+
+/// Step of the finite-difference sensitivities (effects are affine in their gains apart from
+/// the integrated heading, which is not used here).
+const FD_STEP: f64 = 1e-3;
+
+fn quad_of(model: &Model, cand: &Effect, rec: &Record, x0: &[f64], h: usize) -> Quad {
+    quad_multi(model, std::slice::from_ref(cand), rec, x0, h)
+}
+
+/// [`quad_of`] for several effects added together, their gains fitted jointly (in the order
+/// of `cands`, each effect's gains in [`Effect::gains`] order).
+fn quad_multi(model: &Model, cands: &[Effect], rec: &Record, x0: &[f64], h: usize) -> Quad {
+    let zero: Vec<Vec<f64>> = cands.iter().map(|c| vec![0.0; c.gains().len()]).collect();
+    let with = |gains: &[Vec<f64>]| {
+        let mut m = model.clone();
+        for (c, g) in cands.iter().zip(gains) {
+            let mut c = *c;
+            if !g.is_empty() {
+                c.set_gains(g);
+            }
+            m = m.with_effect(c);
+        }
+        m
+    };
+    let e0 = errors(&with(&zero), rec, x0, h);
+    let p: usize = zero.iter().map(Vec::len).sum();
+    let mut cols = Vec::with_capacity(p);
+    for (k, g) in zero.iter().enumerate() {
+        for j in 0..g.len() {
+            let mut gains = zero.clone();
+            gains[k][j] = FD_STEP;
+            let ej = errors(&with(&gains), rec, x0, h);
+            cols.push(
+                e0.iter()
+                    .zip(&ej)
+                    .map(|(a, b)| (a - b) / FD_STEP)
+                    .collect::<Vec<f64>>(),
+            );
+        }
+    }
+    let mut q = Quad::zero(p);
+    q.n = e0.len();
+    for (t, e) in e0.iter().enumerate() {
+        if !e.is_finite() {
+            q.ee = f64::INFINITY;
+            continue;
+        }
+        q.ee += e * e;
+        for i in 0..p {
+            q.se[i] += cols[i][t] * e;
+            for j in 0..=i {
+                q.ss[(i, j)] += cols[i][t] * cols[j][t];
+            }
+        }
+    }
+    for i in 0..p {
+        for j in 0..i {
+            q.ss[(j, i)] = q.ss[(i, j)];
+        }
+    }
+    q
+}
+
+/// The candidates (grid) of one effect kind, with zero gains.
+pub(super) fn grid(kind: EffectKind, ts: f64, u_max: f64, du_max: f64) -> Vec<Effect> {
+    match kind {
+        EffectKind::DeadTime => {
+            let dmax = ((8.0 / ts).ceil() as usize).clamp(1, 20);
+            (1..=dmax)
+                .map(|d| Effect::DeadTime { samples: d })
+                .collect()
+        }
+        EffectKind::RateLimit => {
+            // slew rates that bind on the recorded commands: from 0.5 °/s to the largest
+            // command step, geometric
+            let hi = (du_max / ts).max(1.0);
+            let lo = 0.5_f64.min(hi / 2.0);
+            geometric(lo, hi * 0.9, 12)
+                .into_iter()
+                .map(|rate| Effect::RateLimit { rate })
+                .collect()
+        }
+        EffectKind::Saturation => geometric(0.2 * u_max, 0.95 * u_max, 12)
+            .into_iter()
+            .map(|limit| Effect::Saturation { limit })
+            .collect(),
+        EffectKind::DeadBand => band_widths(u_max)
+            .into_iter()
+            .map(|width| Effect::DeadBand { width })
+            .collect(),
+        EffectKind::NonlinearDamping => vec![
+            Effect::NonlinearDamping {
+                beta: 0.0,
+                cubic: false,
+            },
+            Effect::NonlinearDamping {
+                beta: 0.0,
+                cubic: true,
+            },
+        ],
+        // one structure each, the gains to be fitted
+        EffectKind::Bias
+        | EffectKind::GyroBias
+        | EffectKind::Asymmetry
+        | EffectKind::Wind
+        | EffectKind::Current => vec![Effect::zero(kind, 0.0)],
+    }
+}
+
+/// The dead-band widths searched, by diagnose and by augment alike: 12 geometric steps from
+/// 0.2° to 6° (worn steering gears show 0.5–3°), or to 40 % of the largest command when that
+/// is smaller. A wider "band" on large-amplitude records (zig-zags) only trades the command's
+/// amplitude against the model's gain, so it is not searched.
+///
+/// ```
+/// let w = yawcast::diagnose::band_widths(20.0);
+/// assert_eq!(w.len(), 12);
+/// assert!((w[0] - 0.2).abs() < 1e-12 && (w[11] - 6.0).abs() < 1e-9);
+/// assert!((yawcast::diagnose::band_widths(5.0)[11] - 2.0).abs() < 1e-9);
+/// ```
+pub fn band_widths(u_max: f64) -> Vec<f64> {
+    geometric(0.2, 6.0_f64.min(0.4 * u_max), 12)
+}
+
+fn geometric(lo: f64, hi: f64, n: usize) -> Vec<f64> {
+    if !(lo > 0.0 && hi > lo) {
+        return vec![hi.max(1e-6)];
+    }
+    let r = (hi / lo).powf(1.0 / (n - 1) as f64);
+    (0..n).map(|i| lo * r.powi(i as i32)).collect()
+}
+
+/// A set of records with the base model's x̂(0) per record.
+pub(super) struct Set<'a> {
+    recs: Vec<&'a Record>,
+    x0: Vec<Vec<f64>>,
+}
+
+impl<'a> Set<'a> {
+    pub(super) fn new(model: &Model, recs: &'a [Record]) -> Set<'a> {
+        Set {
+            recs: recs.iter().collect(),
+            x0: recs
+                .iter()
+                .map(|r| predict::estimate_x0(model, r))
+                .collect(),
+        }
+    }
+
+    pub(super) fn from_owned(model: &Model, recs: &'a [Record]) -> Set<'a> {
+        Set::new(model, recs)
+    }
+
+    /// Quads of every candidate, summed over records.
+    pub(super) fn family(
+        &self,
+        model: &Model,
+        cands: &[Effect],
+        h: usize,
+        parallel: bool,
+    ) -> Vec<Quad> {
+        let one = |c: &Effect| {
+            let mut q = Quad::zero(c.gains().len());
+            for (r, x0) in self.recs.iter().zip(&self.x0) {
+                q.add(&quad_of(model, c, r, x0, h));
+            }
+            q
+        };
+        crate::par::map(cands, parallel, one)
+    }
+
+    /// Quads of every pair of candidates (both added, their gains fitted jointly), summed
+    /// over records.
+    pub(super) fn pairs(
+        &self,
+        model: &Model,
+        pairs: &[(Effect, Effect)],
+        h: usize,
+        parallel: bool,
+    ) -> Vec<Quad> {
+        let one = |(a, b): &(Effect, Effect)| {
+            let mut q = Quad::zero(a.gains().len() + b.gains().len());
+            for (r, x0) in self.recs.iter().zip(&self.x0) {
+                q.add(&quad_multi(model, &[*a, *b], r, x0, h));
+            }
+            q
+        };
+        crate::par::map(pairs, parallel, one)
+    }
+
+    /// SSE of the base model at horizon h.
+    pub(super) fn sse0(&self, model: &Model, h: usize) -> (f64, usize) {
+        let mut s = 0.0;
+        let mut n = 0;
+        for (r, x0) in self.recs.iter().zip(&self.x0) {
+            let e = errors(model, r, x0, h);
+            s += e.iter().map(|v| v * v).sum::<f64>();
+            n += e.len();
+        }
+        (s, n)
+    }
+}
+
+/// The version of an effect a record set shows: `None` (the base model) or a candidate index
+/// with its gains.
+#[derive(Debug, Clone)]
+pub(super) struct Version {
+    pub(super) idx: Option<usize>,
+    pub(super) beta: DVector<f64>,
+}
+
+/// Best candidate of a family: (index, gains, SSE).
+fn best_of(quads: &[Quad]) -> (usize, DVector<f64>, f64) {
+    let mut best = (0, DVector::zeros(0), f64::INFINITY);
+    for (i, q) in quads.iter().enumerate() {
+        let (b, s) = q.best();
+        if s < best.2 {
+            best = (i, b, s);
+        }
+    }
+    best
+}
+
+/// The version a set shows: the best candidate when it beats the base model.
+fn version_of(quads: &[Quad], sse0: f64) -> Version {
+    let (i, b, s) = best_of(quads);
+    if s < sse0 {
+        Version {
+            idx: Some(i),
+            beta: b,
+        }
+    } else {
+        Version {
+            idx: None,
+            beta: DVector::zeros(0),
+        }
+    }
+}
+
+fn sse_at(quads: &[Quad], sse0: f64, v: &Version) -> f64 {
+    match v.idx {
+        None => sse0,
+        Some(i) => quads[i].sse(&v.beta),
+    }
+}
+
+/// `D = N·ln(SSE(reference version)/SSE(best))` on a trial set, with the best candidate.
+pub(super) fn trial_statistic(
+    quads: &[Quad],
+    sse0: f64,
+    n: usize,
+    reference: &Version,
+) -> (f64, usize, DVector<f64>) {
+    let base = sse_at(quads, sse0, reference);
+    let (i, b, s) = best_of(quads);
+    let s = s.min(base);
+    let d = n as f64 * (base / s).ln();
+    (d.max(0.0), i, b)
+}
+
+/// The candidate with its gains set.
+pub(super) fn effect_with(cand: &Effect, beta: &DVector<f64>) -> Effect {
+    let mut e = *cand;
+    if !beta.is_empty() {
+        e.set_gains(beta.as_slice());
+    }
+    e
+}
+
+/// What one "world" (a model, its reference records, trial records) shows for one effect.
+#[derive(Debug, Clone)]
+pub(super) struct WorldStat {
+    pub(super) d: f64,
+    pub(super) best: Effect,
+    pub(super) n: usize,
+    /// The version of the effect the reference shows (its best candidate with its gains, when
+    /// it beats the model there).
+    pub(super) reference: Option<Effect>,
+}
+
+/// The statistic `D` of every kind in one world: the reference version of each effect is
+/// fitted on `reference` (none when empty), `D` measured on `trial`.
+pub(super) fn world(
+    model: &Model,
+    reference: &[Record],
+    trial: &[Record],
+    grids: &[(EffectKind, Vec<Effect>)],
+    parallel: bool,
+) -> Vec<WorldStat> {
+    let tset = Set::new(model, trial);
+    let rset = Set::new(model, reference);
+    let one = |(kind, cands): &(EffectKind, Vec<Effect>)| {
+        let h = horizon_of(*kind);
+        let (t0, tn) = tset.sse0(model, h);
+        let tq = tset.family(model, cands, h, false);
+        let version = if reference.is_empty() {
+            Version {
+                idx: None,
+                beta: DVector::zeros(0),
+            }
+        } else {
+            let (r0, _) = rset.sse0(model, h);
+            let rq = rset.family(model, cands, h, false);
+            version_of(&rq, r0)
+        };
+        let (d, bi, bb) = trial_statistic(&tq, t0, tn, &version);
+        WorldStat {
+            d,
+            best: effect_with(&cands[bi], &bb),
+            n: tn,
+            reference: version.idx.map(|i| effect_with(&cands[i], &version.beta)),
+        }
+    };
+    crate::par::map(grids, parallel, one)
+}

@@ -1,0 +1,113 @@
+//! What the reference records show of their own: the steering-gear dynamics the linear
+//! reference model has absorbed into its poles, and whether the model given looks
+//! identified from the reference records at all.
+
+use yawcast_shared::model::EffectKind;
+
+use super::evidence::Set;
+use super::DiagnoseConfig;
+use crate::identify::model::Model;
+use crate::identify::pem::{self, PemConfig};
+use crate::io::data::Record;
+use crate::stats::chi2_sf;
+
+/// The actuator effects that are gear *dynamics*: a slow or delayed gear changes when the
+/// rudder/pod angle arrives, which a linear model absorbs into its poles (a lag), so with θ
+/// frozen the reference shows neither. An angle limit is static: θ cannot absorb it (it
+/// changes the gain at large angles, not the dynamics), so the frozen reference version
+/// already holds it — and on a hull whose turning rate grows less than linearly with the
+/// rudder angle a re-identified angle limit would stand for that hull physics instead.
+const GEAR_DYNAMICS: [EffectKind; 2] = [EffectKind::DeadTime, EffectKind::RateLimit];
+
+/// The actuator physics the reference records show of their own: the reference model with
+/// it, θ re-identified on the reference, and the explanation's sentence.
+#[derive(Debug, Clone)]
+pub(super) struct RefActuator {
+    pub(super) model: Model,
+    pub(super) words: String,
+}
+
+/// The reference's own steering-gear physics (module docs): forward selection over the
+/// actuator effects the model lacks, on the reference records, by [`crate::diagnose::augment`]'s rule
+/// (re-identified, kept only when the held-out part of the reference pays for it or the
+/// reference supports it decisively). `None` when it keeps none.
+pub(super) fn reference_actuator(
+    model: &Model,
+    reference: &[Record],
+    cfg: &DiagnoseConfig,
+) -> Option<RefActuator> {
+    let kinds: Vec<EffectKind> = EffectKind::ALL
+        .iter()
+        .copied()
+        .filter(|k| GEAR_DYNAMICS.contains(k) && model.effect(*k).is_none())
+        .collect();
+    if kinds.is_empty() {
+        return None;
+    }
+    let f = crate::diagnose::augment::forward(model, reference, &[], &kinds, &cfg.augment).ok()?;
+    if f.added.is_empty() || !f.model.is_stable() {
+        return None;
+    }
+    let own: Vec<String> = f
+        .added
+        .iter()
+        .filter_map(|k| f.model.effect(*k))
+        .map(|e| crate::diagnose::augment::describe(e, model.ts))
+        .collect();
+    let words = format!(
+        " The reference records show steering-gear physics of their own that the linear \
+         model has absorbed into its poles: {} (re-identified on the reference, held-out \
+         10-step fit there {:.1} → {:.1} %). A gear the model only approximates looks like \
+         whatever actuator effect mimics it best on each record's commands, so every \
+         statistic is measured against the reference model with it.",
+        own.join(" and "),
+        f.before.get("10").copied().unwrap_or(f64::NAN),
+        f.after.get("10").copied().unwrap_or(f64::NAN),
+    );
+    Some(RefActuator {
+        model: f.model,
+        words,
+    })
+}
+
+/// Is the model fitted to the trials rather than the reference? Then it has absorbed what
+/// the trials show — a slew or angle limit above all — and the statistics against the
+/// reference lose their power. Said when the model is significantly worse on the reference
+/// than the same structure re-identified there (likelihood ratio; ≈ 0 for the reference's
+/// own model) *and* predicts the trials better than that re-identified model does. On
+/// blocks of a longer reference (`WINDOW`) the model was identified on more than the
+/// blocks, whose own optimum beats it by their sampling spread alone: there the excess
+/// must also reach 1 % of the one-step error.
+///
+/// `Some(pct)` when said, `pct` being how much larger (%) the model's one-step error on the
+/// reference is than that of the re-identified structure; `(s1, n1)` are the model's
+/// one-step SSE and error count on the reference, `trial` the trial records with the
+/// model's x̂(0), `min_pct` the excess required (1 on blocks of a longer reference, else 0).
+pub(super) fn foreign(
+    model: &Model,
+    reference: &[Record],
+    est: &[Record],
+    trial: &Set<'_>,
+    (s1, n1): (f64, usize),
+    min_pct: f64,
+    alpha: f64,
+) -> Option<f64> {
+    let pc = PemConfig {
+        order: model.n,
+        max_iter: 50,
+        parallel: false,
+        ..PemConfig::default()
+    };
+    pem::identify_from(reference, model, &pc)
+        .ok()
+        .and_then(|r| {
+            let v = s1 / n1.max(1) as f64;
+            let lr = n1 as f64 * (v / r.cost).ln();
+            let p = r.names.len() as f64;
+            let (t_given, _) = trial.sse0(model, 1);
+            let (t_ref, _) = Set::new(&r.model, est).sse0(&r.model, 1);
+            let pct = 100.0 * (v / r.cost - 1.0);
+            (lr.is_finite() && chi2_sf(lr, p) < alpha && t_given < t_ref && pct >= min_pct)
+                .then_some(pct)
+        })
+}

@@ -1,0 +1,656 @@
+//! The verdict: each effect's evidence in words, the ranking (current or wind, the
+//! encompassing test between the top two), materiality on held-out records, and the
+//! explanation.
+
+use std::collections::BTreeMap;
+
+use yawcast_shared::model::EffectKind;
+
+use super::augment::AugmentReport;
+use super::channels::{add_channels, Channels, SogEvidence};
+use super::compare::mean_fit;
+use super::evidence::{effect_with, horizon_of, Quad, Set, WorldStat};
+use super::null::Null;
+use super::{DiagnoseConfig, Ranked, SLOW_HORIZON, WINDOW, WINDOW_BLOCK};
+use crate::identify::model::{Effect, Model};
+use crate::identify::predict::Horizon;
+use crate::io::data::Record;
+
+/// Number of effects tested (Bonferroni: each is judged at α / m).
+pub(super) fn cfg_m(_cfg: &DiagnoseConfig) -> f64 {
+    EffectKind::ALL.len() as f64
+}
+
+/// Everything computed for one effect kind.
+#[derive(Debug, Clone)]
+pub(super) struct Evidence {
+    pub(super) kind: EffectKind,
+    pub(super) h: usize,
+    pub(super) null: Null,
+    pub(super) best: Effect,
+    pub(super) p: f64,
+    /// p-value of the yaw channel alone (before any other channel is combined in).
+    pub(super) p_yaw: f64,
+    pub(super) score: f64,
+    pub(super) statistic: f64,
+    pub(super) words: String,
+    pub(super) parameter: Option<f64>,
+    pub(super) channel_material: bool,
+    /// The version of the effect the reference shows (θ frozen), if any.
+    pub(super) reference: Option<Effect>,
+    /// Current or wind shown by speed over ground while the yaw channel shows no
+    /// heading-dependent moment ([`current_or_wind`]).
+    pub(super) speed_only: bool,
+}
+
+/// One effect kind's evidence: its statistic `D` against its bootstrap null, in words
+/// ([`yaw_words`]), with what the heading and speed-over-ground channels add
+/// ([`add_channels`]).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn effect_evidence(
+    model: &Model,
+    kind: EffectKind,
+    stat: &WorldStat,
+    null_reps: &[f64],
+    has_ref: bool,
+    cfg: &DiagnoseConfig,
+    hb: Option<(f64, f64)>,
+    sog: Option<SogEvidence>,
+) -> Evidence {
+    let ts = model.ts;
+    let h = horizon_of(kind);
+    let d = stat.d;
+    let tn = stat.n;
+    let best = stat.best;
+    let null = Null::fit(null_reps);
+    let p_yaw = null.p(d);
+    let mut ev = Evidence {
+        kind,
+        h,
+        null,
+        best,
+        p: p_yaw,
+        p_yaw,
+        score: null.excess(d),
+        statistic: d,
+        words: String::new(),
+        parameter: None,
+        channel_material: false,
+        reference: stat.reference,
+        speed_only: false,
+    };
+    let pct = 100.0 * (1.0 - (-d / tn.max(1) as f64).exp());
+    yaw_words(&mut ev, ts, pct);
+    add_channels(&mut ev, has_ref, cfg, hb, sog);
+    ev
+}
+
+/// The yaw channel's evidence of `ev.best` in words (`pct`: the share of the error energy
+/// it removes), with the effect's structural parameter in physical units.
+fn yaw_words(ev: &mut Evidence, ts: f64, pct: f64) {
+    let best = ev.best;
+    let p_yaw = ev.p_yaw;
+    match best {
+        Effect::DeadTime { samples } => {
+            let s = samples as f64 * ts;
+            ev.parameter = Some(s);
+            ev.words = format!(
+                "errors follow the steering commands late; a dead time of {s:.1} s removes {pct:.0} % of \
+                 the one-step error energy the reference version leaves"
+            );
+        }
+        Effect::RateLimit { rate } => {
+            ev.parameter = Some(rate);
+            ev.words = format!(
+                "errors grow right after fast steering reversals; a slew limit of {rate:.1} °/s explains \
+                 {pct:.0} % of the one-step error energy"
+            );
+        }
+        Effect::Saturation { limit } => {
+            ev.parameter = Some(limit);
+            ev.words = format!(
+                "large rudder/pod angles turn the ship less than the model expects; an angle limit of \
+                 {limit:.1}° explains {pct:.0} % of the one-step error energy"
+            );
+        }
+        Effect::DeadBand { width } => {
+            ev.parameter = Some(width);
+            ev.words = format!(
+                "small steering corrections do not reach the ship and reversals arrive short; a \
+                 dead band of {width:.2}° explains {pct:.0} % of the one-step error energy"
+            );
+        }
+        Effect::Asymmetry { beta } => {
+            ev.parameter = Some(beta);
+            ev.words = format!(
+                "starboard commands act {} than port ones (gain {beta:+.3} on max(δ,0)); explains \
+                 {pct:.0} % of the one-step error energy",
+                if beta > 0.0 { "harder" } else { "softer" }
+            );
+        }
+        Effect::NonlinearDamping { beta, cubic } => {
+            ev.parameter = Some(beta);
+            ev.words = format!(
+                "fast turns are damped {} than the model expects ({} gain {beta:+.4}); explains \
+                 {pct:.0} % of the one-step error energy",
+                if beta < 0.0 { "more" } else { "less" },
+                if cubic { "r³" } else { "r|r|" }
+            );
+        }
+        Effect::Bias { beta } => {
+            ev.parameter = Some(beta);
+            ev.words = format!(
+                "a steady yaw moment worth {beta:+.2}° of rudder/pod angle; explains {pct:.0} % of the \
+                 {SLOW_HORIZON}-step error energy"
+            );
+        }
+        Effect::GyroBias { d_y } => {
+            ev.parameter = Some(d_y);
+            ev.words = format!(
+                "the yaw rate reads {d_y:+.3} °/s off on the {SLOW_HORIZON}-step errors ({pct:.0} % of their energy)"
+            );
+        }
+        Effect::Wind { .. } => {
+            ev.words = format!(
+                "a yaw moment with the heading's 1st and 2nd harmonics takes {pct:.0} % of the \
+                 {SLOW_HORIZON}-step error energy (yaw channel: p {})",
+                fmt_p(p_yaw)
+            );
+        }
+        Effect::Current { .. } => {
+            ev.words = format!(
+                "a yaw moment with the heading's 1st harmonic takes {pct:.0} % of the \
+                 {SLOW_HORIZON}-step error energy (yaw channel: p {})",
+                fmt_p(p_yaw)
+            );
+        }
+    }
+}
+
+/// The effects ranked (module docs): the significant first, among them those their own
+/// channel shows, each group by likelihood gain above noise; then current or wind decided
+/// ([`current_or_wind`]) and the top two put through the encompassing test ([`encompass`]).
+pub(super) fn rank(
+    base: &Model,
+    trial: &Set<'_>,
+    ev: &mut Vec<Evidence>,
+    grids: &[(EffectKind, Vec<Effect>)],
+    level: f64,
+    cfg: &DiagnoseConfig,
+    speed: bool,
+) {
+    ev.sort_by(|a, b| {
+        let key = |e: &Evidence| ((e.p < level) as u8, e.channel_material as u8);
+        key(b).cmp(&key(a)).then(
+            b.score
+                .partial_cmp(&a.score)
+                .unwrap_or(std::cmp::Ordering::Equal),
+        )
+    });
+    current_or_wind(ev, level, cfg.alpha, speed);
+    encompass(
+        base,
+        trial,
+        ev,
+        grids,
+        level,
+        cfg.alpha,
+        cfg.parallel,
+        speed,
+    );
+}
+
+/// An effect named from speed over ground alone — current or wind while the yaw channel
+/// shows no heading-dependent moment ([`Evidence::speed_only`]) — that buys no held-out
+/// yaw-rate prediction is not named ahead of a significant effect that does: it explains
+/// none of the yaw-rate departures the other one explains, and a yaw-rate predictor is what
+/// the model is. The first such effect behind it moves ahead of it (`gains[i]`: held-out
+/// gain and fits of the significant effects, in the order of `ev`).
+pub(super) fn yaw_before_speed(
+    ev: &mut Vec<Evidence>,
+    gains: &mut Vec<Option<(f64, BTreeMap<String, f64>)>>,
+) {
+    let gain = |g: &Option<(f64, BTreeMap<String, f64>)>| g.as_ref().map(|g| g.0);
+    let material = |e: &Evidence, g: &Option<(f64, BTreeMap<String, f64>)>| {
+        g.is_some() && (e.channel_material || gain(g).is_some_and(|v| v > 0.0))
+    };
+    let Some(i) = (0..ev.len()).find(|&i| material(&ev[i], &gains[i])) else {
+        return;
+    };
+    let gi = gain(&gains[i]).unwrap_or(0.0);
+    if !ev[i].speed_only || gi > 0.0 {
+        return;
+    }
+    let Some(j) =
+        (i + 1..ev.len()).find(|&j| !ev[j].speed_only && gain(&gains[j]).is_some_and(|v| v > 0.0))
+    else {
+        return;
+    };
+    let gj = gain(&gains[j]).unwrap_or(0.0);
+    let words = format!(
+        "; named behind {}: only speed over ground shows it (the yaw channel shows no \
+         heading-dependent moment) and it buys no held-out yaw-rate prediction ({gi:+.1} pp), \
+         where {} is significant in the yaw rate and buys {gj:+.1} pp",
+        ev[j].kind.name(),
+        ev[j].kind.name(),
+    );
+    ev[i].words.push_str(&words);
+    let e = ev.remove(j);
+    ev.insert(i, e);
+    let g = gains.remove(j);
+    gains.insert(i, g);
+}
+
+/// Current or wind, when speed over ground is logged (module docs): a uniform current carries
+/// the ship without a heading-dependent yaw moment, wind turns it. "Wind" nests "current"
+/// (the speed harmonics are free in both; wind adds the yaw-moment harmonics), so the
+/// likelihood-ratio test between them is the yaw channel's heading-harmonic statistic against
+/// its bootstrap null — first harmonic (current's regressors) or first and second (wind's),
+/// Bonferroni over the two, one test at level α. When either effect is significant, the one
+/// this test names is ranked ahead of the other; wind named this way is significant when
+/// both the heading dependence (the better of the two effects' p-values) and the yaw moment
+/// are (intersection–union: the larger p-value), and material when the speed channel shows
+/// the heading dependence.
+pub(super) fn current_or_wind(ev: &mut Vec<Evidence>, level: f64, alpha: f64, speed: bool) {
+    let pos = |ev: &[Evidence], k: EffectKind| ev.iter().position(|e| e.kind == k);
+    let (Some(ic), Some(iw)) = (pos(ev, EffectKind::Current), pos(ev, EffectKind::Wind)) else {
+        return;
+    };
+    if !speed || (ev[ic].p >= level && ev[iw].p >= level) {
+        return;
+    }
+    let p_moment = (2.0 * ev[ic].p_yaw.min(ev[iw].p_yaw)).min(1.0);
+    let wind = p_moment < alpha;
+    let words = format!(
+        "; yaw moment varying with heading: p {} ({}): {}",
+        fmt_p(p_moment),
+        if wind { "present" } else { "absent" },
+        if wind {
+            "the ship is turned by it, wind (a current carries the ship without turning it)"
+        } else {
+            "speed over ground alone depends on heading, the water carries the ship: a current"
+        }
+    );
+    ev[ic].words.push_str(&words);
+    ev[iw].words.push_str(&words);
+    ev[ic].speed_only = !wind;
+    ev[iw].speed_only = !wind;
+    if wind {
+        let heading_p = ev[ic].p.min(ev[iw].p);
+        let cm = ev[ic].channel_material;
+        let w = &mut ev[iw];
+        w.p = w.p.min(heading_p.max(p_moment));
+        w.channel_material |= cm;
+    }
+    let (win, lose) = if wind { (iw, ic) } else { (ic, iw) };
+    if win > lose {
+        let e = ev.remove(win);
+        ev.insert(lose, e);
+    }
+}
+
+/// Encompassing test between the top two significant effects: both fitted jointly, each
+/// over its whole grid (a dead time and a slew limit that mimic each other alone settle on
+/// other values together); what does each add, given the other, beyond the version the
+/// reference shows? `adds_a = N·ln(SSE(a at its reference version, b free)/SSE(both free))`,
+/// judged against a's own bootstrap null. The one that adds nothing significant given the
+/// other is explained by it (and, when neither adds anything, the simpler one is kept). An
+/// effect shown by its own channel is not displaced by one that is not.
+#[allow(clippy::too_many_arguments)]
+fn encompass(
+    model: &Model,
+    trial: &Set<'_>,
+    ev: &mut [Evidence],
+    grids: &[(EffectKind, Vec<Effect>)],
+    level: f64,
+    alpha: f64,
+    par: bool,
+    speed: bool,
+) {
+    if ev.len() < 2 || ev[1].p >= level {
+        return;
+    }
+    // current vs wind with speed over ground logged: decided by `current_or_wind`
+    let pair = [ev[0].kind, ev[1].kind];
+    if speed && pair.contains(&EffectKind::Current) && pair.contains(&EffectKind::Wind) {
+        return;
+    }
+    if ev[0].channel_material != ev[1].channel_material {
+        return;
+    }
+    // on the slower horizon every effect is visible; the scale of the null comes from an
+    // effect judged on that horizon
+    let h = ev[0].h.max(ev[1].h);
+    let cands = |x: &Evidence| -> Vec<Effect> {
+        grids
+            .iter()
+            .find(|(k, _)| *k == x.kind)
+            .map_or_else(|| vec![zero_gains(&x.best)], |(_, g)| g.clone())
+    };
+    let (a, b) = (&ev[0], &ev[1]);
+    let (ca, cb) = (cands(a), cands(b));
+    let best_sse = |q: &[Quad]| q.iter().map(|q| q.best().1).fold(f64::INFINITY, f64::min);
+    // one effect held at the version the reference shows (the model itself when it shows
+    // none), the other over its grid
+    let held = |x: &Evidence, other: &[Effect]| {
+        let m = match x.reference {
+            Some(r) => model.clone().with_effect(r),
+            None => model.clone(),
+        };
+        best_sse(&trial.family(&m, other, h, par))
+    };
+    let sa_ref = held(a, &cb);
+    let sb_ref = held(b, &ca);
+    let product: Vec<(Effect, Effect)> = ca
+        .iter()
+        .flat_map(|x| cb.iter().map(move |y| (*x, *y)))
+        .collect();
+    let sab = best_sse(&trial.pairs(model, &product, h, par))
+        .min(sa_ref)
+        .min(sb_ref);
+    let n = trial.sse0(model, h).1 as f64;
+    let adds_a = (n * (sa_ref / sab).ln()).max(0.0);
+    let adds_b = (n * (sb_ref / sab).ln()).max(0.0);
+    let scale = |x: &Evidence| {
+        if x.h == h {
+            x.null
+        } else if a.h == h {
+            a.null
+        } else {
+            b.null
+        }
+    };
+    // degrees of freedom of what one adds given the other: wind nests current (its first
+    // harmonics are current's regressors), so wind adds only its second harmonics
+    let frac = |x: &Evidence, y: &Evidence| -> f64 {
+        let (gx, gy) = (x.best.gains().len(), y.best.gains().len());
+        let nested = x.kind == EffectKind::Wind && y.kind == EffectKind::Current;
+        if nested && gx > gy {
+            (gx - gy) as f64 / gx as f64
+        } else {
+            1.0
+        }
+    };
+    let (mut na_, mut nb_) = (scale(a), scale(b));
+    na_.nu *= frac(a, b);
+    nb_.nu *= frac(b, a);
+    // one test of one pair: level α
+    let (pa, pb) = (na_.p(adds_a), nb_.p(adds_b));
+    let sig_a = pa < alpha;
+    let sig_b = pb < alpha;
+    let simpler_b = b.best.gains().len() < a.best.gains().len();
+    let (xa, xb) = (na_.excess(adds_a), nb_.excess(adds_b));
+    let swap = match (sig_a, sig_b) {
+        // b adds what a misses, a adds nothing given b
+        (false, true) => true,
+        // both add: the larger gain above noise wins
+        (true, true) => xb > xa,
+        // neither adds given the other: the simpler one
+        (false, false) => simpler_b,
+        (true, false) => false,
+    };
+    let adds = |x: &str, y: &str, p: f64| {
+        if p < alpha {
+            format!("given {y}, {x} still adds (p {})", fmt_p(p))
+        } else {
+            format!("given {y}, {x} adds nothing significant (p {})", fmt_p(p))
+        }
+    };
+    let (na, nb) = (a.kind.name(), b.kind.name());
+    let w = format!(
+        "; encompassing test ({h}-step errors, both fitted together, each measured from the \
+         version the reference shows): {}; {}",
+        adds(na, nb, pa),
+        adds(nb, na, pb),
+    );
+    ev[0].words.push_str(&w);
+    ev[1].words.push_str(&w);
+    if swap {
+        ev.swap(0, 1);
+    }
+}
+
+fn zero_gains(e: &Effect) -> Effect {
+    let mut c = *e;
+    let g = vec![0.0; e.gains().len()];
+    c.set_gains(&g);
+    c
+}
+
+/// The effect's own held-out contribution: θ frozen, the effect's structure as found, its
+/// gains refitted on `est`; (gain pp at the effect's horizon — 10 steps for actuator and hull
+/// effects, `sim` for slow ones —, held-out fits with the effect).
+pub(super) fn frozen_gain(
+    model: &Model,
+    e: &Evidence,
+    est: &Set<'_>,
+    held_out: &[Record],
+    before: &BTreeMap<String, f64>,
+    parallel: bool,
+) -> (f64, BTreeMap<String, f64>) {
+    let cand = zero_gains(&e.best);
+    let q = est.family(model, &[cand], e.h, parallel);
+    let (beta, _) = q[0].best();
+    let m = model.clone().with_effect(effect_with(&cand, &beta));
+    let fits = mean_fit(&m, held_out, &Horizon::REPORT);
+    let key = if e.h == 1 { "10" } else { "sim" };
+    let gain = match (fits.get(key), before.get(key)) {
+        (Some(a), Some(b)) if (a - b).is_finite() => a - b,
+        _ => f64::NEG_INFINITY,
+    };
+    (gain, fits)
+}
+
+/// Held-out fit % keyed by horizon ("1","5","10","20","sim").
+type Fits = BTreeMap<String, f64>;
+
+/// The ranking in the order of `ev` (`gains[i]`: held-out gain and fits of the significant
+/// effects), and the verdict: the first effect both significant and material, with its
+/// held-out fits (θ frozen).
+pub(super) fn ranked(
+    ev: &[Evidence],
+    gains: &[Option<(f64, Fits)>],
+    level: f64,
+) -> (Vec<Ranked>, Option<(usize, Fits)>) {
+    let mut ranking = Vec::new();
+    let mut verdict: Option<(usize, BTreeMap<String, f64>)> = None;
+    for (i, (e, g)) in ev.iter().zip(gains).enumerate() {
+        let significant = e.p < level;
+        let fit_gain = g.as_ref().map_or(0.0, |g| g.0);
+        let material = significant && (e.channel_material || fit_gain > 0.0);
+        if material && verdict.is_none() {
+            verdict = g.as_ref().map(|g| (i, g.1.clone()));
+        }
+        ranking.push(Ranked {
+            effect: e.kind.name().into(),
+            statistic: e.statistic,
+            p_value: e.p,
+            above_noise: e.score,
+            fit_gain_pp: fit_gain,
+            significant,
+            material,
+            parameter: e.parameter,
+            evidence: e.words.clone(),
+        });
+    }
+    (ranking, verdict)
+}
+
+/// The verdict in words: the verdict's name, the explanation's opening sentences, the
+/// held-out fits after, and the confirming refit (`verdict`: the index of the verdict's
+/// effect in `ev` and `ranking`, its held-out fits and refit).
+pub(super) fn verdict_words(
+    ev: &[Evidence],
+    ranking: &[Ranked],
+    verdict: Option<(usize, BTreeMap<String, f64>, Option<AugmentReport>)>,
+    has_ref: bool,
+    alpha: f64,
+    before: &BTreeMap<String, f64>,
+) -> (String, String, BTreeMap<String, f64>, Option<AugmentReport>) {
+    match verdict {
+        Some((i, after, aug)) => {
+            let e = &ev[i];
+            let r = &ranking[i];
+            let mut s = format!(
+                "The trials show {} that the {} lacks: {} (p {}, held-out fit gain {:+.1} pp).",
+                effect_phrase(e.kind),
+                if has_ref { "reference" } else { "model" },
+                e.words,
+                fmt_p(r.p_value),
+                r.fit_gain_pp
+            );
+            if let Some((_, second)) = ranking
+                .iter()
+                .enumerate()
+                .find(|(j, x)| *j != i && x.significant)
+            {
+                s.push_str(&format!(
+                    " Runner-up: {} (p {}, likelihood gain above noise {:.0} against {:.0}, \
+                     held-out fit gain {:+.1} pp).",
+                    second.effect,
+                    fmt_p(second.p_value),
+                    second.above_noise,
+                    r.above_noise,
+                    second.fit_gain_pp
+                ));
+                if second.p_value < r.p_value {
+                    s.push_str(
+                        " Effects are ranked by their likelihood gain above noise (the \
+                         statistic less its null mean), not by p: p-values this far in the \
+                         tail rest on the shape fitted to the null replicates and cannot be \
+                         compared between effects.",
+                    );
+                }
+            }
+            if let Some(a) = &aug {
+                s.push_str(&format!(" Refitted with the model: {}", a.explanation));
+            }
+            (e.kind.name().to_string(), s, after, aug)
+        }
+        None => {
+            let sig: Vec<&Ranked> = ranking.iter().filter(|r| r.significant).collect();
+            let s = if sig.is_empty() {
+                format!(
+                    "No effect of the library is significant at α = {} against its null \
+                     distribution: the trials show nothing the {} lacks.",
+                    alpha,
+                    if has_ref { "reference" } else { "model" }
+                )
+            } else {
+                format!(
+                    "{} significant but not material: refitted, {} not improve held-out \
+                     prediction, so the model is kept without it.",
+                    sig.iter()
+                        .map(|r| r.effect.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    if sig.len() == 1 { "it does" } else { "they do" }
+                )
+            };
+            ("none".to_string(), s, before.clone(), None)
+        }
+    }
+}
+
+/// The explanation's closing sentences: the reference's own gear, the blocks of long
+/// records, and what weakens the evidence (no reference, a model that does not look
+/// identified from it, heading or speed over ground not logged).
+pub(super) fn caveats(
+    explanation: &mut String,
+    gear_words: Option<&str>,
+    windows: &[Option<Vec<Record>>; 3],
+    has_ref: bool,
+    foreign_pct: Option<f64>,
+    ch: &Channels,
+) {
+    let windowed = windows.iter().any(Option::is_some);
+    if let Some(w) = gear_words {
+        explanation.push_str(w);
+    }
+    if windowed {
+        let count = |w: &Option<Vec<Record>>| w.as_ref().map_or(0, Vec::len);
+        explanation.push_str(&format!(
+            " Records of more than {WINDOW} samples per set are diagnosed on blocks of up to \
+             {WINDOW_BLOCK} samples spread evenly over them ({} of the trials, {} of the \
+             reference, {} of the held-out records; 0: used whole).",
+            count(&windows[0]),
+            count(&windows[1]),
+            count(&windows[2]),
+        ));
+    }
+    if !has_ref {
+        explanation.push_str(
+            " No reference records were given, so every statistic is judged against the \
+             model alone: hull nonlinearity the model never had shows up as an effect, and the \
+             verdict is weaker.",
+        );
+    }
+    if let Some(pct) = foreign_pct {
+        explanation.push_str(&format!(
+            " The model does not look identified from the reference records: its one-step \
+             error there is {pct:.0} % above that of the same structure re-identified on them, \
+             and it predicts the trials better than that model does. A model identified or \
+             tuned on the trials has absorbed part of what they show (an actuator limit above \
+             all), so the evidence is weaker; the strongest test uses the model identified on \
+             the reference records."
+        ));
+    }
+    if !ch.heading_ok {
+        explanation.push_str(
+            " Heading is not logged in every record: a gyro bias cannot be told apart from a \
+             constant yaw moment (bias), and wind and current are tested on the heading \
+             integrated from the measured yaw rate, from an unknown start (0°) and drifting \
+             with any rate offset.",
+        );
+    }
+    if !ch.speed_ok {
+        explanation.push_str(
+            " Speed over ground (or heading) is not logged in every record: current and wind \
+             are judged from the yaw rate alone and are hard to tell apart from a bias.",
+        );
+    }
+}
+
+/// Hold-out split: the last 30 % of each record (kept long enough for the slow horizon).
+pub(super) fn split(est: &[Record]) -> (Vec<Record>, Vec<Record>) {
+    let mut a = Vec::new();
+    let mut b = Vec::new();
+    for r in est {
+        let n = r.len();
+        let cut = (n * 7 / 10).max(n.saturating_sub(n / 3));
+        a.push(r.slice(0, cut));
+        b.push(r.slice(cut, n));
+    }
+    (a, b)
+}
+
+/// `= 3.1e-5`, or `< 1e-16` where the number is below what the tail computation resolves.
+fn fmt_p(p: f64) -> String {
+    if p < 1e-16 {
+        "< 1e-16".into()
+    } else {
+        format!("= {p:.1e}")
+    }
+}
+
+/// The effect in a few words ("a command dead time"), as the verdict, the demo and its report
+/// name it.
+///
+/// ```
+/// use yawcast_shared::model::EffectKind;
+/// assert_eq!(yawcast::diagnose::effect_phrase(EffectKind::DeadBand), "a steering-gear dead band");
+/// ```
+pub fn effect_phrase(kind: EffectKind) -> &'static str {
+    match kind {
+        EffectKind::Bias => "a constant yaw moment",
+        EffectKind::GyroBias => "a rate-gyro offset",
+        EffectKind::DeadTime => "a command dead time",
+        EffectKind::RateLimit => "a rudder/pod slew-rate limit",
+        EffectKind::Saturation => "a rudder/pod angle limit",
+        EffectKind::Asymmetry => "a port/starboard steering asymmetry",
+        EffectKind::NonlinearDamping => "extra nonlinear yaw damping",
+        EffectKind::Wind => "a heading-dependent wind moment",
+        EffectKind::Current => "a current",
+        EffectKind::DeadBand => "a steering-gear dead band",
+    }
+}
