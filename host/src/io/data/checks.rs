@@ -1,0 +1,315 @@
+//! Plausibility of a record: physical limits, units, heading unwrapping and a uniform time grid.
+
+use std::path::Path;
+
+use super::{Columns, DataError, Record, SNAP_TOL};
+
+/// Physical limits a record's values must respect (after unit scaling): a value beyond them
+/// is a corrupted cell or another unit, never a measurement to identify from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Limits {
+    /// Largest |commanded angle| (deg). Rudders and pods turn at most 35–45°, azimuth units 180°.
+    pub angle_deg: f64,
+    /// Largest |yaw rate| (deg/s).
+    pub rate_degps: f64,
+    /// Largest |speed over ground| and relative wind speed (m/s).
+    pub speed_mps: f64,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            angle_deg: 180.0,
+            rate_degps: 30.0,
+            speed_mps: 100.0,
+        }
+    }
+}
+
+/// Smallest span (max − min) of the command for a record to carry information (deg).
+pub const MIN_COMMAND_SPAN_DEG: f64 = 0.05;
+/// Smallest span of the yaw rate for a record to carry information (deg/s).
+pub const MIN_RATE_SPAN_DEGPS: f64 = 1e-3;
+
+/// Checks a record before any work is done on it: every value within `limits`, and both the
+/// command and the yaw rate moving (a command held at one angle, or a yaw rate stuck at one
+/// value, cannot be identified, tuned on, compared or diagnosed). `cols` names the columns
+/// in the messages; rows are 1-based samples of the record (for an NMEA log, of its grid).
+///
+/// # Errors
+/// [`DataError::Implausible`] naming the row and column of the first value beyond a limit,
+/// [`DataError::NoExcitation`] naming the column that never moves.
+///
+/// ```
+/// use yawcast::io::data::{validate_record, Columns, DataError, Limits, Record};
+/// let ok = Record::from_uy("r", 1.0, vec![0.0, 5.0, -5.0], vec![0.0, 0.4, -0.2]);
+/// assert!(validate_record(&ok, "r.csv".as_ref(), &Limits::default(), &Columns::default()).is_ok());
+/// let wild = Record::from_uy("r", 1.0, vec![0.0, 2e6, -5.0], vec![0.0, 0.4, -0.2]);
+/// let e = validate_record(&wild, "r.csv".as_ref(), &Limits::default(), &Columns::default());
+/// assert!(matches!(e, Err(DataError::Implausible { row: 2, .. })));
+/// let still = Record::from_uy("r", 1.0, vec![5.0; 3], vec![0.0, 0.4, -0.2]);
+/// let e = validate_record(&still, "r.csv".as_ref(), &Limits::default(), &Columns::default());
+/// assert!(matches!(e, Err(DataError::NoExcitation { .. })));
+/// ```
+pub fn validate_record(
+    rec: &Record,
+    path: &Path,
+    limits: &Limits,
+    cols: &Columns,
+) -> Result<(), DataError> {
+    let within =
+        |v: &[f64], col: &str, limit: f64, what: &'static str, option: &'static str| match v
+            .iter()
+            .position(|x| x.is_nan() || x.abs() > limit)
+        {
+            Some(i) => Err(DataError::Implausible {
+                path: path.to_path_buf(),
+                row: i + 1,
+                column: col.to_string(),
+                value: v[i],
+                limit,
+                what,
+                option,
+            }),
+            None => Ok(()),
+        };
+    within(
+        &rec.u,
+        &cols.u,
+        limits.angle_deg,
+        "a commanded angle (deg)",
+        "--max-angle",
+    )?;
+    within(
+        &rec.y,
+        &cols.y,
+        limits.rate_degps,
+        "a yaw rate (deg/s)",
+        "--max-rate",
+    )?;
+    if let Some(v) = &rec.speed {
+        within(
+            v,
+            &cols.speed,
+            limits.speed_mps,
+            "a speed (m/s)",
+            "--max-speed",
+        )?;
+    }
+    if let Some(v) = &rec.wind_speed {
+        within(
+            v,
+            &cols.wind_speed,
+            limits.speed_mps,
+            "a wind speed (m/s)",
+            "--max-speed",
+        )?;
+    }
+    let span = |v: &[f64]| {
+        let (lo, hi) = v
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| {
+                (l.min(x), h.max(x))
+            });
+        (hi - lo, lo, hi)
+    };
+    let still = |col: &str, v: &[f64], min: f64, unit: &str, why: &str| {
+        let (s, lo, hi) = span(v);
+        if s < min {
+            let held = if s == 0.0 {
+                format!("is constant ({lo} {unit} throughout)")
+            } else {
+                format!("is constant to within {s:.3e} {unit} ({lo} … {hi})")
+            };
+            return Err(DataError::NoExcitation {
+                path: path.to_path_buf(),
+                column: col.to_string(),
+                what: format!("{held}: {why}"),
+            });
+        }
+        Ok(())
+    };
+    still(
+        &cols.u,
+        &rec.u,
+        MIN_COMMAND_SPAN_DEG,
+        "deg",
+        "the command must move for the yaw dynamics to show; a record held at one angle \
+         cannot be identified, tuned on, compared or diagnosed",
+    )?;
+    still(
+        &cols.y,
+        &rec.y,
+        MIN_RATE_SPAN_DEGPS,
+        "deg/s",
+        "the yaw rate never moves; check that the rate sensor is logged, and its column and \
+         unit (--col-rate, --rate-unit)",
+    )
+}
+
+/// Warnings about the scale of a record's columns that suggest a unit mix-up: commands that
+/// never leave ±1.6 (radians under a degree header: π/2 rad is 90°) and yaw rates that never
+/// leave ±0.05 °/s while the commands reach 2° (rad/s under a °/s header: a ship turning
+/// visibly does more than 3°/min), and a sample time above a minute (milliseconds under a
+/// seconds header: no yaw predictor samples that slowly). Empty when nothing looks wrong.
+///
+/// ```
+/// use yawcast::io::data::{unit_warnings, Record};
+/// let r = Record::from_uy("r", 1.0, vec![0.1, -0.2, 0.35], vec![0.001, 0.004, -0.002]);
+/// let w = unit_warnings(&r);
+/// assert_eq!(w.len(), 1);
+/// assert!(w[0].contains("radians"));
+/// let r = Record::from_uy("r", 1.0, vec![10.0, -20.0], vec![0.002, -0.01]);
+/// assert!(unit_warnings(&r)[0].contains("rad/s"));
+/// assert!(unit_warnings(&Record::from_uy("r", 1.0, vec![10.0, -20.0], vec![0.4, -0.9])).is_empty());
+/// let ms = Record::from_uy("r", 1000.0, vec![10.0, -20.0], vec![0.4, -0.9]);
+/// assert!(unit_warnings(&ms)[0].contains("milliseconds"));
+/// ```
+pub fn unit_warnings(rec: &Record) -> Vec<String> {
+    let span = |v: &[f64]| {
+        v.iter()
+            .filter(|x| x.is_finite())
+            .fold(0.0f64, |m, x| m.max(x.abs()))
+    };
+    let (du, dy) = (span(&rec.u), span(&rec.y));
+    let mut out = Vec::new();
+    if rec.ts > 60.0 {
+        out.push(format!(
+            "the sample time is {} s: if the time column is in milliseconds, divide it by 1000",
+            rec.ts
+        ));
+    }
+    if du > 0.0 && du <= 1.6 {
+        out.push(format!(
+            "the commands never leave ±{du:.3}: if they are radians, give --angle-unit rad"
+        ));
+    } else if du >= 2.0 && dy > 0.0 && dy <= 0.05 {
+        out.push(format!(
+            "the yaw rate never leaves ±{dy:.4} °/s while the commands reach {du:.0}°: if it \
+             is in rad/s, give --rate-unit radps"
+        ));
+    }
+    out
+}
+
+/// Removes the 360° jumps of a heading logged in [0, 360) (or (−180, 180]): each sample
+/// moves to within 180° of the one before, so the heading is continuous through north and
+/// its differences are turn angles. Sines and cosines of it are unchanged.
+///
+/// ```
+/// let mut psi = vec![358.0, 359.5, 0.5, 2.0, 1.0, 359.0];
+/// yawcast::io::data::unwrap_degrees(&mut psi);
+/// assert_eq!(psi, vec![358.0, 359.5, 360.5, 362.0, 361.0, 359.0]);
+/// ```
+pub fn unwrap_degrees(psi: &mut [f64]) {
+    let mut offset = 0.0;
+    for i in 1..psi.len() {
+        let raw = psi[i] + offset;
+        let step = raw - psi[i - 1];
+        let turns = ((step + 180.0) / 360.0).floor();
+        offset -= 360.0 * turns;
+        psi[i] = raw - 360.0 * turns;
+    }
+}
+
+/// Checks that `t` advances one sample per period and returns the period.
+///
+/// The period is the median of the steps that go forward. Logged time stamps jitter: a row
+/// may come late or early (the step before it is then longer or shorter, the one after it
+/// the opposite), and each row still holds one sample as long as every step is within half
+/// a period of the period — stamps off their grid by up to a quarter period each. The
+/// sample time returned is the slope of the least-squares line through the stamps, snapped
+/// to a value of at most three significant digits within [`SNAP_TOL`] of it (a logger at
+/// 1 Hz with jitter gives 1 s, not 0.99943 s).
+///
+/// # Errors
+/// [`DataError::NonUniform`] naming the first row whose step is not positive (time going
+/// back or repeated), spans two or more periods (missing samples) or less than half of one
+/// (an extra sample).
+///
+/// ```
+/// use std::path::Path;
+/// let t = [0.0, 1.01, 1.99, 3.0, 4.0, 5.0];
+/// assert_eq!(yawcast::io::data::check_uniform(&t, Path::new("x.csv")).unwrap(), 1.0);
+/// let gap = [0.0, 1.0, 2.0, 4.0, 5.0];
+/// let e = yawcast::io::data::check_uniform(&gap, Path::new("x.csv")).unwrap_err();
+/// assert!(e.to_string().contains("row 4") && e.to_string().contains("1 sample missing"));
+/// ```
+pub fn check_uniform(t: &[f64], path: &Path) -> Result<f64, DataError> {
+    let n = t.len();
+    // the period: the median of the steps that go forward
+    let mut steps: Vec<f64> = t
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|s| *s > 0.0)
+        .collect();
+    steps.sort_by(f64::total_cmp);
+    let h = if steps.is_empty() {
+        f64::NAN
+    } else if steps.len() % 2 == 1 {
+        steps[steps.len() / 2]
+    } else {
+        0.5 * (steps[steps.len() / 2 - 1] + steps[steps.len() / 2])
+    };
+    // the first row that breaks the sampling, in row order
+    for i in 0..n - 1 {
+        let step = t[i + 1] - t[i];
+        let what = if step.is_nan() || step < 0.0 {
+            Some("time goes back".to_string())
+        } else if step == 0.0 {
+            Some("the time stamp repeats the row before".to_string())
+        } else {
+            let periods = (step / h).round();
+            if periods >= 2.0 {
+                let missing = periods - 1.0;
+                Some(format!(
+                    "{missing} sample{} missing; split the record there or fill the gap",
+                    if missing == 1.0 { "" } else { "s" }
+                ))
+            } else if periods < 1.0 {
+                Some(
+                    "less than half a period after the row before (an extra sample); remove it"
+                        .to_string(),
+                )
+            } else {
+                None
+            }
+        };
+        if let Some(what) = what {
+            return Err(DataError::NonUniform {
+                path: path.to_path_buf(),
+                row: i + 2,
+                step,
+                expected: h,
+                what,
+            });
+        }
+    }
+    // the least-squares slope of t against the sample index
+    let mid = (n - 1) as f64 / 2.0;
+    let t_mean = t.iter().sum::<f64>() / n as f64;
+    let (num, den) = t.iter().enumerate().fold((0.0, 0.0), |(a, b), (i, ti)| {
+        let di = i as f64 - mid;
+        (a + di * (ti - t_mean), b + di * di)
+    });
+    Ok(snap((num / den).max(f64::MIN_POSITIVE)))
+}
+
+/// `ts` rounded to the fewest significant digits (one to three) that move it by at most
+/// [`SNAP_TOL`] (relative); `ts` itself when none does.
+fn snap(ts: f64) -> f64 {
+    for digits in 1..=3 {
+        let k = digits - 1 - ts.log10().floor() as i32;
+        let snapped = if k >= 0 {
+            let s = 10f64.powi(k);
+            (ts * s).round() / s
+        } else {
+            let s = 10f64.powi(-k);
+            (ts / s).round() * s
+        };
+        if (snapped - ts).abs() <= SNAP_TOL * ts {
+            return snapped;
+        }
+    }
+    ts
+}

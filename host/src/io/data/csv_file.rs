@@ -1,0 +1,332 @@
+//! The measurement CSV: reading (column names, separators, resampling) and writing.
+
+use std::path::Path;
+
+use super::{check_uniform, unwrap_degrees, write_atomic, DataError, Record};
+
+/// Column names of the measurement CSV (overridable for other loggers).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Columns {
+    /// Time (s).
+    pub t: String,
+    /// Commanded angle.
+    pub u: String,
+    /// Yaw rate.
+    pub y: String,
+    /// Heading (optional column).
+    pub psi: String,
+    /// Speed over ground (optional column).
+    pub speed: String,
+    /// Relative wind speed (optional column).
+    pub wind_speed: String,
+    /// Relative wind angle (optional column).
+    pub wind_angle: String,
+    /// Multiply the angle columns (`u`, `psi`, `wind_angle`) by this to get degrees.
+    pub angle_scale: f64,
+    /// Multiply the yaw-rate column by this to get deg/s.
+    pub rate_scale: f64,
+    /// Resample onto a uniform grid of this step (s) instead of requiring uniform time stamps.
+    pub resample: Option<f64>,
+}
+
+impl Default for Columns {
+    fn default() -> Self {
+        Columns {
+            t: "t_s".into(),
+            u: "delta_deg".into(),
+            y: "r_degps".into(),
+            psi: "psi_deg".into(),
+            speed: "u_mps".into(),
+            wind_speed: "wind_speed_mps".into(),
+            wind_angle: "wind_angle_deg".into(),
+            angle_scale: 1.0,
+            rate_scale: 1.0,
+            resample: None,
+        }
+    }
+}
+
+/// Reads a measurement CSV with the default column names.
+///
+/// # Errors
+/// [`DataError`] naming the file, row and column for missing columns, non-numeric or
+/// non-finite cells, non-monotonic or non-uniform time, or fewer than 2 samples.
+pub fn read_csv(path: &Path) -> Result<Record, DataError> {
+    read_csv_with(path, &Columns::default())
+}
+
+/// Reads a measurement CSV with the given column names and unit scales.
+///
+/// # Errors
+/// As [`read_csv`].
+pub fn read_csv_with(path: &Path, cols: &Columns) -> Result<Record, DataError> {
+    let text = std::fs::read_to_string(path).map_err(|source| DataError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    parse_csv(&text, path, &name, cols)
+}
+
+/// Parses CSV text (`path` only labels errors).
+///
+/// # Errors
+/// As [`read_csv`].
+///
+/// ```
+/// use yawcast::io::data::{parse_csv, Columns};
+/// let txt = "t_s,delta_deg,r_degps\n0,1,0\n1,1,0.5\n2,-1,0.2\n";
+/// let r = parse_csv(txt, "x.csv".as_ref(), "x", &Columns::default()).unwrap();
+/// assert_eq!(r.ts, 1.0);
+/// assert_eq!(r.y, vec![0.0, 0.5, 0.2]);
+/// ```
+pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<Record, DataError> {
+    let csv_err = |e: csv::Error| DataError::Csv {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let semicolons = semicolon_separated(text);
+    let mut rdr = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .comment(Some(b'#'))
+        .delimiter(if semicolons { b';' } else { b',' })
+        .from_reader(text.as_bytes());
+    let headers: Vec<String> = rdr
+        .headers()
+        .map_err(csv_err)?
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    for (j, h) in headers.iter().enumerate() {
+        if let Some(k) = headers[..j].iter().position(|g| g == h) {
+            return Err(DataError::DuplicateColumn {
+                path: path.to_path_buf(),
+                column: h.clone(),
+                first: k + 1,
+                second: j + 1,
+            });
+        }
+    }
+    let find = |c: &str| headers.iter().position(|h| h == c);
+    let need = |c: &str| {
+        find(c).ok_or_else(|| DataError::MissingColumn {
+            path: path.to_path_buf(),
+            column: c.to_string(),
+            found: headers.join(","),
+        })
+    };
+    let it = need(&cols.t)?;
+    let iu = need(&cols.u)?;
+    let iy = need(&cols.y)?;
+    let ipsi = find(&cols.psi);
+    let isp = find(&cols.speed);
+    let iws = find(&cols.wind_speed);
+    let iwa = find(&cols.wind_angle);
+    let mut rec = Record {
+        name: name.to_string(),
+        psi: ipsi.map(|_| Vec::new()),
+        speed: isp.map(|_| Vec::new()),
+        wind_speed: iws.map(|_| Vec::new()),
+        wind_angle: iwa.map(|_| Vec::new()),
+        ..Record::default()
+    };
+    for (i, row) in rdr.records().enumerate() {
+        let row = row.map_err(csv_err)?;
+        let rown = i + 1;
+        let cell = |idx: usize| -> Result<f64, DataError> {
+            let s = row.get(idx).unwrap_or("");
+            // A `;`-separated file writes decimals with a comma (`1,5`).
+            let parsed = if semicolons {
+                s.replace(',', ".").parse::<f64>()
+            } else {
+                s.parse::<f64>()
+            };
+            match parsed {
+                Ok(v) if v.is_finite() => Ok(v),
+                _ => Err(DataError::BadCell {
+                    path: path.to_path_buf(),
+                    row: rown,
+                    column: headers[idx].clone(),
+                    value: s.to_string(),
+                }),
+            }
+        };
+        rec.t.push(cell(it)?);
+        rec.u.push(cell(iu)? * cols.angle_scale);
+        rec.y.push(cell(iy)? * cols.rate_scale);
+        if let (Some(i), Some(v)) = (ipsi, rec.psi.as_mut()) {
+            v.push(cell(i)? * cols.angle_scale);
+        }
+        if let (Some(i), Some(v)) = (isp, rec.speed.as_mut()) {
+            v.push(cell(i)?);
+        }
+        if let (Some(i), Some(v)) = (iws, rec.wind_speed.as_mut()) {
+            v.push(cell(i)?);
+        }
+        if let (Some(i), Some(v)) = (iwa, rec.wind_angle.as_mut()) {
+            v.push(cell(i)? * cols.angle_scale);
+        }
+    }
+    if rec.t.len() < 2 {
+        return Err(DataError::TooShort {
+            path: path.to_path_buf(),
+            found: rec.t.len(),
+            needed: 2,
+        });
+    }
+    if let Some(psi) = rec.psi.as_mut() {
+        unwrap_degrees(psi);
+    }
+    match cols.resample {
+        Some(dt) => resample(&rec, dt, path),
+        None => {
+            rec.ts = check_uniform(&rec.t, path)?;
+            Ok(rec)
+        }
+    }
+}
+
+/// Resamples a record onto the uniform grid `t_0, t_0 + dt, …` within its time span: the
+/// command zero-order held (it is held over each logged interval), every other channel
+/// linearly interpolated (heading and wind angle after unwrapping). The time stamps only need
+/// to increase; a logger's jitter, gaps and another rate are all absorbed.
+///
+/// # Errors
+/// [`DataError::NonUniform`] naming the first row whose time does not increase,
+/// [`DataError::TooShort`] when the grid holds fewer than 2 samples, and
+/// [`DataError::Csv`] when `dt` is not a positive number.
+///
+/// ```
+/// use yawcast::io::data::{resample, Record};
+/// let mut r = Record::from_uy("r", 0.0, vec![1.0, 2.0, 3.0], vec![0.0, 1.0, 3.0]);
+/// r.t = vec![0.0, 0.4, 1.1];
+/// let g = resample(&r, 0.5, "r.csv".as_ref()).unwrap();
+/// assert_eq!(g.t, vec![0.0, 0.5, 1.0]);
+/// assert_eq!(g.u, vec![1.0, 2.0, 2.0]);
+/// assert!((g.y[1] - (1.0 + 2.0 * 0.1 / 0.7)).abs() < 1e-12);
+/// assert_eq!(g.ts, 0.5);
+/// ```
+pub fn resample(rec: &Record, dt: f64, path: &Path) -> Result<Record, DataError> {
+    if !(dt.is_finite() && dt > 0.0) {
+        return Err(DataError::Csv {
+            path: path.to_path_buf(),
+            message: format!("--resample {dt}: expected a positive number of seconds"),
+        });
+    }
+    if let Some(i) = rec
+        .t
+        .windows(2)
+        .position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+    {
+        return Err(DataError::NonUniform {
+            path: path.to_path_buf(),
+            row: i + 2,
+            step: rec.t[i + 1] - rec.t[i],
+            expected: dt,
+            what: "time must increase from row to row, even when resampling".into(),
+        });
+    }
+    let (t0, t1) = (rec.t[0], rec.t[rec.t.len() - 1]);
+    let n = ((t1 - t0) / dt + 1e-9).floor() as usize + 1;
+    if n < 2 {
+        return Err(DataError::TooShort {
+            path: path.to_path_buf(),
+            found: n,
+            needed: 2,
+        });
+    }
+    let grid: Vec<f64> = (0..n).map(|k| t0 + k as f64 * dt).collect();
+    // For each grid time, the logged interval [t_j, t_{j+1}) that holds it and where in it.
+    let mut at = Vec::with_capacity(n);
+    let mut j = 0;
+    for &tg in &grid {
+        while j + 2 < rec.t.len() && rec.t[j + 1] <= tg {
+            j += 1;
+        }
+        let w = ((tg - rec.t[j]) / (rec.t[j + 1] - rec.t[j])).clamp(0.0, 1.0);
+        at.push((j, w));
+    }
+    let held = |v: &[f64]| -> Vec<f64> {
+        at.iter()
+            .map(|&(j, w)| if w >= 1.0 { v[j + 1] } else { v[j] })
+            .collect()
+    };
+    let linear = |v: &[f64]| -> Vec<f64> {
+        at.iter()
+            .map(|&(j, w)| v[j] + w * (v[j + 1] - v[j]))
+            .collect()
+    };
+    let unwrapped = |v: &[f64]| {
+        let mut v = v.to_vec();
+        unwrap_degrees(&mut v);
+        linear(&v)
+    };
+    Ok(Record {
+        name: rec.name.clone(),
+        ts: dt,
+        t: grid,
+        u: held(&rec.u),
+        y: linear(&rec.y),
+        psi: rec.psi.as_deref().map(unwrapped),
+        speed: rec.speed.as_deref().map(linear),
+        wind_speed: rec.wind_speed.as_deref().map(linear),
+        wind_angle: rec.wind_angle.as_deref().map(unwrapped),
+    })
+}
+
+/// Whether the CSV text is `;`-separated (the spreadsheet export of locales with a decimal
+/// comma): its header has a `;` and no `,`.
+pub(super) fn semicolon_separated(text: &str) -> bool {
+    let header = text
+        .lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty() && !l.starts_with('#'))
+        .unwrap_or("");
+    header.contains(';') && !header.contains(',')
+}
+
+/// Writes a record as a measurement CSV ([`csv_text`]), atomically (temp file, then rename).
+///
+/// # Errors
+/// [`DataError::Io`] when the file cannot be written.
+pub fn write_csv(path: &Path, rec: &Record) -> Result<(), DataError> {
+    write_atomic(path, csv_text(rec).as_bytes())
+}
+
+/// A record as a measurement CSV: the header, then one row per sample (numbers in Rust's
+/// shortest round-trip form).
+///
+/// ```
+/// let r = yawcast::io::data::Record::from_uy("r", 0.5, vec![1.0, -2.5], vec![0.125, 0.0]);
+/// assert_eq!(yawcast::io::data::csv_text(&r), "t_s,delta_deg,r_degps\n0,1,0.125\n0.5,-2.5,0\n");
+/// ```
+pub fn csv_text(rec: &Record) -> String {
+    let mut out = String::new();
+    out.push_str("t_s,delta_deg,r_degps");
+    let opt = [
+        (&rec.psi, "psi_deg"),
+        (&rec.speed, "u_mps"),
+        (&rec.wind_speed, "wind_speed_mps"),
+        (&rec.wind_angle, "wind_angle_deg"),
+    ];
+    for (v, name) in &opt {
+        if v.is_some() {
+            out.push(',');
+            out.push_str(name);
+        }
+    }
+    out.push('\n');
+    for i in 0..rec.len() {
+        out.push_str(&format!("{},{},{}", rec.t[i], rec.u[i], rec.y[i]));
+        for (v, _) in &opt {
+            if let Some(v) = v {
+                out.push_str(&format!(",{}", v[i]));
+            }
+        }
+        out.push('\n');
+    }
+    out
+}

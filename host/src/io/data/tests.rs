@@ -1,0 +1,386 @@
+//! Unit tests of the measurement records, the CSV, the checks and the atomic writer.
+
+use std::path::Path;
+
+use super::csv_file::semicolon_separated;
+use super::*;
+
+fn parse(txt: &str) -> Result<Record, DataError> {
+    parse_csv(txt, Path::new("f.csv"), "f", &Columns::default())
+}
+
+#[test]
+fn reads_optional_columns() {
+    let r =
+        parse("t_s,delta_deg,r_degps,psi_deg,u_mps\n0,1,0,10,1.5\n0.5,1,0.1,10.1,1.5\n").unwrap();
+    assert_eq!(r.ts, 0.5);
+    assert_eq!(r.psi, Some(vec![10.0, 10.1]));
+    assert_eq!(r.speed, Some(vec![1.5, 1.5]));
+    assert!(r.wind_speed.is_none());
+}
+
+#[test]
+fn missing_column_is_named() {
+    let e = parse("t_s,delta_deg\n0,1\n1,1\n").unwrap_err().to_string();
+    assert!(e.contains("r_degps") && e.contains("f.csv"), "{e}");
+}
+
+#[test]
+fn bad_cell_names_row_and_column() {
+    let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,x,0\n")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("row 2") && e.contains("delta_deg") && e.contains("`x`"),
+        "{e}"
+    );
+    let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,1,NaN\n")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("r_degps") && e.contains("NaN"), "{e}");
+}
+
+#[test]
+fn jittered_time_stamps_keep_the_loggers_period() {
+    // a 2 Hz logger whose stamps jitter by up to ±0.1 s (20 % of a period)
+    let mut txt = String::from("t_s,delta_deg,r_degps\n");
+    for i in 0..200 {
+        let jitter = 0.1 * (((i * 7919) % 11) as f64 / 5.0 - 1.0);
+        txt.push_str(&format!("{},1,0\n", 0.5 * i as f64 + jitter));
+    }
+    let r = parse(&txt).unwrap();
+    assert_eq!(r.ts, 0.5);
+    // a period far from three significant digits is kept as it is
+    let t: Vec<f64> = (0..10).map(|i| i as f64 * 0.123_456_7).collect();
+    let ts = check_uniform(&t, Path::new("x")).unwrap();
+    assert!((ts - 0.123_456_7).abs() < 1e-15, "{ts}");
+}
+
+#[test]
+fn heading_is_unwrapped_through_north() {
+    let r =
+        parse("t_s,delta_deg,r_degps,psi_deg\n0,1,0,359\n1,1,0,1\n2,1,0,3\n3,1,0,0.5\n").unwrap();
+    assert_eq!(r.psi, Some(vec![359.0, 361.0, 363.0, 360.5]));
+    let mut west = vec![-179.0, 179.0, 170.0, -170.0];
+    unwrap_degrees(&mut west);
+    assert_eq!(west, vec![-179.0, -181.0, -190.0, -170.0]);
+}
+
+#[test]
+fn non_uniform_and_non_monotonic_time() {
+    let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,1,0\n2.5,1,0\n3.5,1,0\n")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("row 3"), "{e}");
+    let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,1,0\n0.5,1,0\n").unwrap_err();
+    assert!(matches!(e, DataError::NonUniform { row: 3, .. }), "{e}");
+    assert!(e.to_string().contains("time goes back"), "{e}");
+    // a gap of three samples, an extra sample, a repeated stamp: each named with its row
+    let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,1,0\n2,1,0\n6,1,0\n7,1,0\n")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("row 4") && e.contains("3 samples missing") && e.contains("sample time is 1 s"),
+        "{e}"
+    );
+    let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,1,0\n1.3,1,0\n2,1,0\n3,1,0\n")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("row 3") && e.contains("extra sample"), "{e}");
+    let e = parse("t_s,delta_deg,r_degps\n0,1,0\n1,1,0\n1,1,0\n2,1,0\n")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("row 3") && e.contains("repeats"), "{e}");
+}
+
+#[test]
+fn round_trip_and_atomic_write() {
+    let dir = std::env::temp_dir().join(format!("yawcast-data-{}", std::process::id()));
+    let p = dir.join("r.csv");
+    let mut r = Record::from_uy("r", 0.25, vec![1.0, -2.5, 3.0], vec![0.125, 0.0, -1.0]);
+    r.psi = Some(vec![0.0, 1.0, 2.0]);
+    write_csv(&p, &r).unwrap();
+    let back = read_csv(&p).unwrap();
+    assert_eq!(back.u, r.u);
+    assert_eq!(back.y, r.y);
+    assert_eq!(back.psi, r.psi);
+    assert_eq!(back.ts, 0.25);
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .contains(".tmp")
+        })
+        .collect();
+    assert!(leftovers.is_empty());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Every entry of `dir` (recursively), as sorted relative paths with their bytes.
+fn listing(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            let rel = p.strip_prefix(dir).unwrap().display().to_string();
+            if p.is_dir() {
+                out.push((rel + "/", Vec::new()));
+                stack.push(p);
+            } else {
+                out.push((rel, std::fs::read(&p).unwrap()));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+fn fresh_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("yawcast-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A rename that fails on the `n`-th file (1-based), counting its calls.
+fn failing_on(n: usize, calls: &mut usize) -> impl FnMut(&Path, &Path) -> std::io::Result<()> + '_ {
+    move |from, to| {
+        *calls += 1;
+        if *calls == n {
+            return Err(std::io::Error::other("injected rename failure"));
+        }
+        std::fs::rename(from, to)
+    }
+}
+
+#[test]
+fn a_rename_failing_after_the_first_output_leaves_no_output() {
+    let d = fresh_dir("fault-new");
+    let files = vec![
+        (d.join("model.postcard"), vec![1u8, 2, 3]),
+        (d.join("sub/deeper/model.json"), b"{}".to_vec()),
+        (d.join("summary.json"), b"{\"a\":1}".to_vec()),
+    ];
+    let mut calls = 0;
+    let e = write_all_atomic_with(&files, &mut failing_on(2, &mut calls)).unwrap_err();
+    assert_eq!(
+        calls, 2,
+        "the first file was renamed into place before the failure"
+    );
+    assert!(
+        matches!(&e, DataError::Io { path, .. } if path == &d.join("sub/deeper/model.json")),
+        "{e}"
+    );
+    assert!(e.to_string().contains("injected rename failure"), "{e}");
+    // no output, no temporary file, no directory created for the outputs
+    assert_eq!(listing(&d), Vec::<(String, Vec<u8>)>::new());
+    // and the same files go through when nothing fails
+    let mut calls = 0;
+    write_all_atomic_with(&files, &mut failing_on(0, &mut calls)).unwrap();
+    assert_eq!(calls, 3);
+    assert_eq!(
+        std::fs::read(d.join("model.postcard")).unwrap(),
+        vec![1u8, 2, 3]
+    );
+    let names: Vec<String> = listing(&d).into_iter().map(|(n, _)| n).collect();
+    assert_eq!(
+        names,
+        [
+            "model.postcard",
+            "sub/",
+            "sub/deeper/",
+            "sub/deeper/model.json",
+            "summary.json"
+        ]
+    );
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn a_failed_write_restores_every_file_it_would_have_replaced() {
+    let d = fresh_dir("fault-old");
+    let old: Vec<(PathBuf, Vec<u8>)> = vec![
+        (d.join("ship.postcard"), vec![0xde, 0xad, 0xbe, 0xef, 0]),
+        (d.join("ship.json"), b"{\"old\": true}\n".to_vec()),
+        (d.join("tables.md"), b"| old |\n".to_vec()),
+    ];
+    for (p, b) in &old {
+        std::fs::write(p, b).unwrap();
+    }
+    let before = listing(&d);
+    let new: Vec<(PathBuf, Vec<u8>)> = old
+        .iter()
+        .map(|(p, _)| (p.clone(), b"new content".to_vec()))
+        .chain([(d.join("fresh.json"), b"{}".to_vec())])
+        .collect();
+    for fail_at in 1..=4 {
+        let mut calls = 0;
+        let e = write_all_atomic_with(&new, &mut failing_on(fail_at, &mut calls)).unwrap_err();
+        assert!(
+            matches!(&e, DataError::Io { path, .. } if path == &new[fail_at - 1].0),
+            "{e}"
+        );
+        assert_eq!(listing(&d), before, "failing at rename {fail_at}");
+    }
+    // a write that goes through replaces all and leaves no backup
+    write_all_atomic(&new).unwrap();
+    let after = listing(&d);
+    assert_eq!(after.len(), 4, "{after:?}");
+    assert!(after.iter().all(|(_, b)| b == b"new content" || b == b"{}"));
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn two_outputs_to_one_file_are_refused_before_any_write() {
+    let d = fresh_dir("dup");
+    let files = vec![
+        (d.join("a.json"), b"1".to_vec()),
+        (d.join("a.json"), b"2".to_vec()),
+    ];
+    let e = write_all_atomic(&files).unwrap_err();
+    assert!(e.to_string().contains("two outputs"), "{e}");
+    assert!(listing(&d).is_empty());
+    let e = check_outputs(&[&d.join("x"), &d.join("x")]).unwrap_err();
+    assert!(e.to_string().contains("two outputs"), "{e}");
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// An interrupt arriving between two renames: the writer rolls back under its lock before
+/// `interrupt` returns, and writes nothing afterwards.
+#[test]
+fn an_interrupt_during_the_renames_rolls_back_before_it_returns() {
+    let d = fresh_dir("interrupt");
+    std::fs::write(d.join("model.postcard"), b"old blob").unwrap();
+    let before = listing(&d);
+    let writer = std::sync::Arc::new(AtomicWriter::new());
+    let files = vec![
+        (d.join("model.json"), b"new twin".to_vec()),
+        (d.join("model.postcard"), b"new blob".to_vec()),
+    ];
+    let (renamed_tx, renamed_rx) = std::sync::mpsc::channel();
+    let w = writer.clone();
+    let f = files.clone();
+    let handle = std::thread::spawn(move || {
+        let mut first = true;
+        w.write_all(&f, &mut |from, to| {
+            std::fs::rename(from, to)?;
+            if first {
+                first = false;
+                // The twin is in place, the blob not yet: wait here for the signal.
+                renamed_tx.send(()).unwrap();
+                while w.interrupted().is_none() {
+                    std::thread::yield_now();
+                }
+            }
+            Ok(())
+        })
+    });
+    renamed_rx.recv().unwrap();
+    assert_eq!(std::fs::read(d.join("model.json")).unwrap(), b"new twin");
+    let guard = writer.interrupt(15);
+    // The lock is ours: the write has rolled back already.
+    assert_eq!(listing(&d), before);
+    drop(guard);
+    let res = handle.join().unwrap();
+    assert!(
+        matches!(res, Err(DataError::Interrupted { signal: 15 })),
+        "{res:?}"
+    );
+    // later writes touch nothing
+    let e = writer
+        .write_all(&files, &mut |a, b| std::fs::rename(a, b))
+        .unwrap_err();
+    assert!(matches!(e, DataError::Interrupted { signal: 15 }), "{e}");
+    assert!(e.to_string().contains("no output written"), "{e}");
+    assert_eq!(listing(&d), before);
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn duplicate_columns_are_named_not_resolved() {
+    let e = parse("t_s,delta_deg,r_degps,delta_deg\n0,1,0,2\n1,2,1,3\n").unwrap_err();
+    assert!(
+        matches!(&e, DataError::DuplicateColumn { column, first: 2, second: 4, .. } if column == "delta_deg"),
+        "{e}"
+    );
+}
+
+#[test]
+fn semicolon_files_with_decimal_commas_are_read() {
+    let r = parse("t_s;delta_deg;r_degps\n0;1,5;0\n0,5;-2;0,25\n1;3;-0,125\n").unwrap();
+    assert_eq!(r.ts, 0.5);
+    assert_eq!(r.u, vec![1.5, -2.0, 3.0]);
+    assert_eq!(r.y, vec![0.0, 0.25, -0.125]);
+    // A comma file whose cells hold `;` stays a comma file (and fails on the cell).
+    assert!(!semicolon_separated("t_s,delta_deg;x,r_degps\n"));
+}
+
+#[test]
+fn implausible_values_and_still_channels_are_named() {
+    let cols = Columns::default();
+    let lim = Limits::default();
+    let path = Path::new("trial.csv");
+    let mut r = Record::from_uy(
+        "r",
+        1.0,
+        vec![0.0, 4.0, -4.0, 2.0],
+        vec![0.0, 0.5, -0.5, 0.1],
+    );
+    assert!(validate_record(&r, path, &lim, &cols).is_ok());
+    r.y[2] = 3.4e200;
+    let e = validate_record(&r, path, &lim, &cols).unwrap_err();
+    assert!(
+        matches!(&e, DataError::Implausible { row: 3, column, limit, .. } if column == "r_degps" && *limit == 30.0),
+        "{e}"
+    );
+    assert!(e.to_string().contains("--max-rate"), "{e}");
+    r.y[2] = -0.5;
+    r.speed = Some(vec![1.0, 1.0, 150.0, 1.0]);
+    let e = validate_record(&r, path, &lim, &cols).unwrap_err();
+    assert!(matches!(e, DataError::Implausible { row: 3, .. }), "{e}");
+    r.speed = None;
+    let zero = Record::from_uy("z", 1.0, vec![0.0; 4], vec![0.0; 4]);
+    let e = validate_record(&zero, path, &lim, &cols).unwrap_err();
+    assert!(
+        matches!(&e, DataError::NoExcitation { column, .. } if column == "delta_deg"),
+        "{e}"
+    );
+    let tiny = Record::from_uy(
+        "t",
+        1.0,
+        vec![0.0, 5.0, 0.0, 5.0],
+        vec![1e-300, 0.0, 2e-300, 0.0],
+    );
+    let e = validate_record(&tiny, path, &lim, &cols).unwrap_err();
+    assert!(
+        matches!(&e, DataError::NoExcitation { column, .. } if column == "r_degps"),
+        "{e}"
+    );
+    assert!(e.to_string().contains("constant"), "{e}");
+}
+
+#[test]
+fn resampling_absorbs_gaps_and_another_rate() {
+    // A 2 s gap that uniform reading refuses is resampled onto 0.5 s.
+    let txt = "t_s,delta_deg,r_degps,psi_deg\n0,1,0,358\n1,1,1,359\n3,-1,3,1\n4,-1,2,2\n";
+    assert!(parse(txt).is_err());
+    let cols = Columns {
+        resample: Some(0.5),
+        ..Columns::default()
+    };
+    let r = parse_csv(txt, "g.csv".as_ref(), "g", &cols).unwrap();
+    assert_eq!(r.ts, 0.5);
+    assert_eq!(r.t.len(), 9);
+    assert_eq!(r.u, vec![1.0, 1.0, 1.0, 1.0, 1.0, 1.0, -1.0, -1.0, -1.0]);
+    assert_eq!(r.y[3], 1.5);
+    assert_eq!(r.y[8], 2.0);
+    // Heading through north: 359 → 361 (unwrapped), half-way 360.
+    assert_eq!(r.psi.as_ref().unwrap()[4], 360.0);
+    let back = "t_s,delta_deg,r_degps\n0,1,0\n1,1,1\n1,2,2\n";
+    let e = parse_csv(back, "b.csv".as_ref(), "b", &cols).unwrap_err();
+    assert!(matches!(e, DataError::NonUniform { row: 3, .. }), "{e}");
+}

@@ -1,0 +1,142 @@
+//! Unit tests of the NMEA reader: the sample logs, the small parsers, clocks, gaps and errors.
+
+use super::*;
+
+const TRIAL: &str = include_str!("../../../tests/data/trial.nmea");
+const BAD: &str = include_str!("../../../tests/data/trial-bad-checksum.nmea");
+const GAP: &str = include_str!("../../../tests/data/trial-gap.nmea");
+
+fn parse(text: &str, opts: &NmeaOptions) -> Result<Record, NmeaError> {
+    parse_nmea(text, Path::new("trial.nmea"), "trial", opts)
+}
+
+#[test]
+fn golden_log_every_sentence_type() {
+    let r = parse(TRIAL, &NmeaOptions::default()).unwrap();
+    assert_eq!(r.ts, 0.5);
+    assert_eq!(r.len(), 19);
+    let t: Vec<f64> = (0..19).map(|i| i as f64 * 0.5).collect();
+    assert_eq!(r.t, t);
+    // ROT 6·t deg/min = 0.1·t deg/s; the invalid ROT at 2.5 s is interpolated over.
+    for (i, &ti) in t.iter().enumerate() {
+        assert!((r.y[i] - 0.1 * ti).abs() < 1e-9, "r at {ti}: {}", r.y[i]);
+        let d = if ti < 5.0 { 10.0 } else { -10.0 };
+        assert_eq!(r.u[i], d, "δ at {ti}");
+    }
+    // HDT 358 + 0.5 t, unwrapped across north; HDG is ignored when HDT is logged.
+    let psi = r.psi.as_ref().unwrap();
+    assert_eq!(psi[0], 358.0);
+    assert_eq!(psi[1], 358.25);
+    assert_eq!(psi[18], 362.5);
+    // VTG 3 kn; MWV relative 10 kn at 356 + t deg (wrapped), true-wind MWV ignored.
+    assert!(r.speed.as_ref().unwrap().iter().all(|&v| v == 1.543333));
+    assert!(r
+        .wind_speed
+        .as_ref()
+        .unwrap()
+        .iter()
+        .all(|&v| v == 5.144444));
+    let wa = r.wind_angle.as_ref().unwrap();
+    assert_eq!(wa[0], 356.0);
+    assert_eq!(wa[8], 0.0);
+    assert_eq!(wa[18], 5.0);
+}
+
+#[test]
+fn bad_checksum_names_the_line() {
+    let e = parse(BAD, &NmeaOptions::default()).unwrap_err();
+    assert!(matches!(e, NmeaError::Checksum { line: 49, .. }), "{e}");
+    let msg = e.to_string();
+    assert!(msg.contains("trial.nmea: line 49: bad checksum"), "{msg}");
+    // Dropping the line instead: the ROT sample at 4.0 s is interpolated from its neighbours.
+    let opts = NmeaOptions {
+        skip_bad_checksums: true,
+        ..NmeaOptions::default()
+    };
+    let r = parse(BAD, &opts).unwrap();
+    assert_eq!(r.len(), 19);
+}
+
+#[test]
+fn gap_names_time_line_and_length() {
+    let e = parse(GAP, &NmeaOptions::default()).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        matches!(
+            e,
+            NmeaError::Gap {
+                line: 40,
+                sentence: "ROT",
+                ..
+            }
+        ),
+        "{msg}"
+    );
+    assert!(
+        msg.contains("gap of 3.50 s in ROT (rate of turn) after 12:00:03.50 (line 40)"),
+        "{msg}"
+    );
+    // A generous limit lets it through.
+    let opts = NmeaOptions {
+        max_gap: Some(4.0),
+        ..NmeaOptions::default()
+    };
+    assert_eq!(parse(GAP, &opts).unwrap().len(), 19);
+}
+
+#[test]
+fn hdg_and_rmc_clock_without_hdt_and_zda() {
+    let log: String = TRIAL
+        .lines()
+        .filter(|l| !l.contains("HDT") && !l.contains("ZDA"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let r = parse(&log, &NmeaOptions::default()).unwrap();
+    assert_eq!(r.len(), 19);
+    assert_eq!(r.psi.as_ref().unwrap()[18], 362.5);
+}
+
+#[test]
+fn rate_clock_and_grid_option() {
+    let opts = NmeaOptions {
+        clock: Clock::Rate(2.0),
+        ts: Some(1.0),
+        ..NmeaOptions::default()
+    };
+    let r = parse(TRIAL, &opts).unwrap();
+    assert_eq!(r.ts, 1.0);
+    // Every ROT ticks the clock (the invalid one too); heading starts at the 2nd tick.
+    assert!((r.y[3] - 0.35).abs() < 1e-9, "{:?}", r.y);
+}
+
+#[test]
+fn clear_errors() {
+    let e = parse(
+        "$GPZDA,120000.00,14,06,2024,00,00*62\n",
+        &NmeaOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("at least 2") && e.contains("--nmea-rate"), "{e}");
+    let no_rsa: String = TRIAL
+        .lines()
+        .filter(|l| !l.contains("RSA"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let e = parse(&no_rsa, &NmeaOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("no valid RSA sentence"), "{e}");
+    let e = parse("$HEROT,abc,A*65\n", &NmeaOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("line 1: ROT") && e.contains("`abc`"), "{e}");
+    let e = parse(
+        "$GPZDA,120001.00,14,06,2024,00,00*63\n$GPZDA,120000.00,14,06,2024,00,00*62\n",
+        &NmeaOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("line 2: clock goes back"), "{e}");
+    assert!(!looks_like_nmea(""));
+}
