@@ -57,6 +57,8 @@ EFFECTS = [
     "wind",
     "current",
 ]
+# The whole library, for reading verdicts and models (the suite hides the effects above).
+LIBRARY = EFFECTS + ["dead-band"]
 
 # --------------------------------------------------------------------------------------
 # records
@@ -179,7 +181,7 @@ def standin_record(name, seed, n=2000, ts=0.5, noise=0.05, effect=None):
 class SSModel:
     """x(t+1) = A x + B v + K e;  ŷ = C x + D ũ + d_y + y0;  ũ = actuator(u − u0);
     v = ũ + Σ β φ (yawcast effects; empty for peers).  Step semantics follow docs/method.md
-    and host/src/identify/predict.rs: actuator (dead time → saturation → rate limit), heading,
+    and host/src/identify/predict.rs: actuator (dead time → saturation → dead band → rate limit), heading,
     y_used, effect regressors, innovation, state update, heading integration."""
 
     def __init__(self, A, B, C, D=0.0, K=None, u0=0.0, y0=0.0, ts=1.0, effects=None, name=""):
@@ -198,6 +200,7 @@ class SSModel:
         self.dead = int(e.get("dead", 0))
         self.rate = e.get("rate")
         self.limit = e.get("limit")
+        self.band = e.get("band")
         self.d_y = float(e.get("d_y", 0.0))
         self.bias = float(e.get("bias", 0.0))
         self.asym = float(e.get("asym", 0.0))
@@ -210,7 +213,8 @@ class SSModel:
     @property
     def has_effects(self):
         return bool(
-            self.dead or self.rate is not None or self.limit is not None or self.d_y
+            self.dead or self.rate is not None or self.limit is not None
+            or self.band is not None or self.d_y
             or self.bias or self.asym or self.damp or self.heading
         )
 
@@ -238,6 +242,8 @@ class SSModel:
                 eff["rate"] = float(e["rate"])
             elif kind == "saturation":
                 eff["limit"] = float(e["limit"])
+            elif kind == "dead-band":
+                eff["band"] = float(e["width"])
             elif kind == "asymmetry":
                 eff["asym"] = e["beta"]
             elif kind == "nonlinear-damping":
@@ -299,7 +305,7 @@ def _initial(m: SSModel, x0, psi0, count=1):
 def _step(m: SSModel, st: _State, u, y=None, psi_meas=None):
     """One predictor step for all origins in `st` (arrays of length M, or scalars).
     y=None: no measurement (open loop).  Returns ŷ made before the step."""
-    # actuator chain on u − u0: dead time, saturation, rate limit
+    # actuator chain on u − u0: dead time, saturation, dead band, rate limit
     uc = np.broadcast_to(np.asarray(u, dtype=float) - m.u0, st.uprev.shape)
     if m.dead:
         delayed = st.delay[:, 0].copy()
@@ -308,6 +314,9 @@ def _step(m: SSModel, st: _State, u, y=None, psi_meas=None):
     else:
         delayed = uc
     target = np.clip(delayed, -m.limit, m.limit) if m.limit is not None else delayed
+    if m.band is not None:
+        # the pod stays until the target is more than the band away, then follows that far behind
+        target = np.clip(st.uprev, target - m.band, target + m.band)
     if m.rate is not None:
         s = m.rate * m.ts
         ut = st.uprev + np.clip(target - st.uprev, -s, s)
@@ -446,6 +455,8 @@ def _peek_actuator(m: SSModel, st: _State, u):
     else:
         delayed = uc
     target = np.clip(delayed, -m.limit, m.limit) if m.limit is not None else delayed
+    if m.band is not None:
+        target = np.clip(tmp.uprev, target - m.band, target + m.band)
     if m.rate is not None:
         s = m.rate * m.ts
         return tmp.uprev + np.clip(target - tmp.uprev, -s, s)
@@ -850,6 +861,7 @@ def cmd_selftest(_args=None):
                 [],
                 [{"effect": "dead-time", "samples": 2}],
                 [{"effect": "rate-limit", "rate": 4.0}, {"effect": "saturation", "limit": 12.0}],
+                [{"effect": "dead-band", "width": 1.5}, {"effect": "rate-limit", "rate": 4.0}],
                 [{"effect": "bias", "beta": 0.3}, {"effect": "gyro-bias", "d_y": 0.05}],
                 [{"effect": "asymmetry", "beta": 0.2}, {"effect": "nonlinear-damping", "beta": -0.5, "cubic": False}],
                 [{"effect": "nonlinear-damping", "beta": -0.2, "cubic": True}],
@@ -1213,7 +1225,7 @@ def run_case_yawcast(yc, case, mdir, rows, args, log_print):
             dj = mdir / "diagnose.json"
             wall_d, ddoc = yc.diagnose(refm, case.est, case.ref, dj, seed)
             verdict = _find(ddoc, "verdict", "effect", "best", "missing")
-            named = verdict if isinstance(verdict, str) and verdict in EFFECTS else "none"
+            named = verdict if isinstance(verdict, str) and verdict in LIBRARY else "none"
             aug = mdir / "yawcast-aug.postcard"
             wall_a, t_a, adoc = yc.augment(refm, case.est, named, aug, seed)
             adoc = adoc if isinstance(adoc, dict) else {}
@@ -1670,7 +1682,7 @@ def notes(meta, args):
         "each (the hull's own nonlinear damping, which diagnose rightly does not name: the simulator's records "
         "need it as much); when the model written carries no effect, the row is plain PEM on the raw estimation "
         "record. Its models are read from the JSON twin (a, b, k and the effects) and scored by the same "
-        "predictor, effects included (dead time → saturation → rate limit, bias, asymmetry, damping, heading "
+        "predictor, effects included (dead time → saturation → dead band → rate limit, bias, asymmetry, damping, heading "
         "terms, gyro bias), as `host/src/identify/predict.rs` defines them.",
     ]
     if meta.get("compare_max_delta") is not None:
