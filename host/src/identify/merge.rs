@@ -161,16 +161,7 @@ pub struct Merged {
 fn sym_pinv(m: &DMatrix<f64>) -> (DMatrix<f64>, usize) {
     let n = m.nrows();
     // Jacobi scaling keeps parameters of different magnitudes from hiding each other.
-    let d: Vec<f64> = (0..n)
-        .map(|i| {
-            let v = m[(i, i)];
-            if v > 0.0 && v.is_finite() {
-                1.0 / v.sqrt()
-            } else {
-                1.0
-            }
-        })
-        .collect();
+    let d = crate::identify::pem::jacobi_scale(m);
     let s = DMatrix::from_fn(n, n, |i, j| m[(i, j)] * d[i] * d[j]);
     // bounded iterations: a matrix the eigen-solver cannot take has rank 0 here (no
     // information), not a hang

@@ -35,6 +35,71 @@ pub struct ZigzagResult {
     pub time_to_switch_s: f64,
 }
 
+/// Bookkeeping of a turning circle, shared by every simulator: fed each sample's heading
+/// change `dpsi` (deg, positive into the turn), position (x ahead, y into the turn, m), yaw
+/// rate (deg/s) and speed (m/s).
+#[derive(Debug)]
+pub(crate) struct TurningTracker {
+    prev: Option<(f64, f64, f64)>, // (Δψ deg, x, y)
+    at90: Option<(f64, f64)>,
+    at180: Option<(f64, f64)>,
+    r_sum: f64,
+    sp_sum: f64,
+    cnt: usize,
+    done: bool,
+}
+
+impl TurningTracker {
+    pub(crate) fn new() -> TurningTracker {
+        TurningTracker {
+            prev: None,
+            at90: None,
+            at180: None,
+            r_sum: 0.0,
+            sp_sum: 0.0,
+            cnt: 0,
+            done: false,
+        }
+    }
+
+    /// Observes one sample; `false` once the heading has turned 450° (the run may stop).
+    pub(crate) fn observe(&mut self, dpsi: f64, x: f64, y: f64, r_degps: f64, speed: f64) -> bool {
+        if let Some((p, px, py)) = self.prev {
+            for (target, slot) in [(90.0, &mut self.at90), (180.0, &mut self.at180)] {
+                if slot.is_none() && p < target && dpsi >= target {
+                    let w = (target - p) / (dpsi - p);
+                    *slot = Some((px + w * (x - px), py + w * (y - py)));
+                }
+            }
+        }
+        self.prev = Some((dpsi, x, y));
+        if (360.0..450.0).contains(&dpsi) {
+            self.r_sum += r_degps;
+            self.sp_sum += speed;
+            self.cnt += 1;
+        }
+        self.done = dpsi >= 450.0;
+        !self.done
+    }
+
+    /// The figures, or why there are none (`within` says how long the run was allowed).
+    pub(crate) fn result(&self, delta_deg: f64, within: &str) -> Result<TurningResult, SimError> {
+        match (self.at90, self.at180, self.done && self.cnt > 0) {
+            (Some((adv, tr)), Some((_, td)), true) => Ok(TurningResult {
+                advance_m: adv,
+                transfer_m: tr,
+                tactical_diameter_m: td,
+                steady_r_degps: self.r_sum / self.cnt as f64,
+                steady_speed_mps: self.sp_sum / self.cnt as f64,
+            }),
+            _ => Err(SimError::Manoeuvre {
+                manoeuvre: "turning circle",
+                reason: format!("heading did not change by 450°{within} at δ = {delta_deg}°"),
+            }),
+        }
+    }
+}
+
 /// Bookkeeping of a zig-zag's overshoots, shared by every simulator: fed each sample's
 /// heading change (deg) before the command logic sees it.
 #[derive(Debug)]
@@ -136,49 +201,22 @@ pub fn turning_circle(ship: &Ship, delta_deg: f64) -> Result<TurningResult, SimE
     }
     let sg = delta_deg.signum();
     let spec = settled(ship);
-    let mut prev: Option<(f64, f64, f64)> = None; // (Δψ deg, x, y)
-    let mut at90 = None;
-    let mut at180 = None;
-    let (mut r_sum, mut sp_sum, mut cnt) = (0.0, 0.0, 0usize);
-    let mut done = false;
+    let mut track = TurningTracker::new();
     run(
         &spec,
         |_, _| delta_deg,
         |smp| {
             let s = smp.state;
-            let dpsi = sg * s[5].to_degrees();
-            let (x, y) = (s[3], sg * s[4]);
-            if let Some((p, px, py)) = prev {
-                for (target, slot) in [(90.0, &mut at90), (180.0, &mut at180)] {
-                    if slot.is_none() && p < target && dpsi >= target {
-                        let w = (target - p) / (dpsi - p);
-                        *slot = Some((px + w * (x - px), py + w * (y - py)));
-                    }
-                }
-            }
-            prev = Some((dpsi, x, y));
-            if (360.0..450.0).contains(&dpsi) {
-                r_sum += s[2].to_degrees();
-                sp_sum += s[0].hypot(s[1]);
-                cnt += 1;
-            }
-            done = dpsi >= 450.0;
-            !done
+            track.observe(
+                sg * s[5].to_degrees(),
+                s[3],
+                sg * s[4],
+                s[2].to_degrees(),
+                s[0].hypot(s[1]),
+            )
         },
     )?;
-    match (at90, at180, done && cnt > 0) {
-        (Some((adv, tr)), Some((_, td)), true) => Ok(TurningResult {
-            advance_m: adv,
-            transfer_m: tr,
-            tactical_diameter_m: td,
-            steady_r_degps: r_sum / cnt as f64,
-            steady_speed_mps: sp_sum / cnt as f64,
-        }),
-        _ => Err(SimError::Manoeuvre {
-            manoeuvre: "turning circle",
-            reason: format!("heading did not change by 450° within {T_MAX} s at δ = {delta_deg}°"),
-        }),
-    }
+    track.result(delta_deg, &format!(" within {T_MAX} s"))
 }
 
 /// Zig-zag `delta_deg`/`psi_deg` (10/10, 20/20, …) from a steady straight approach,

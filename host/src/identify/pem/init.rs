@@ -15,11 +15,11 @@ pub(crate) fn actuator_output(template: &Model, rec: &Record) -> Vec<f64> {
     rec.u.iter().map(|u| s.actuator(&mut st, *u)).collect()
 }
 
-/// Solves the symmetric positive (semi-)definite system `h x = b` with Jacobi scaling, falling
-/// back to a tiny ridge and then to an SVD pseudo-inverse. `None` when nothing works.
-pub(crate) fn spd_solve(h: &DMatrix<f64>, b: &DVector<f64>) -> Option<DVector<f64>> {
-    let n = h.nrows();
-    let d: Vec<f64> = (0..n)
+/// Jacobi scaling of a symmetric matrix: `1/√h_ii` where that diagonal entry is positive and
+/// finite, else 1 — so that parameters of different magnitudes do not hide each other in
+/// `D h D` (used by the solves and inverses of identification and merging).
+pub(crate) fn jacobi_scale(h: &DMatrix<f64>) -> Vec<f64> {
+    (0..h.nrows())
         .map(|i| {
             let v = h[(i, i)];
             if v > 0.0 && v.is_finite() {
@@ -28,7 +28,14 @@ pub(crate) fn spd_solve(h: &DMatrix<f64>, b: &DVector<f64>) -> Option<DVector<f6
                 1.0
             }
         })
-        .collect();
+        .collect()
+}
+
+/// Solves the symmetric positive (semi-)definite system `h x = b` with Jacobi scaling, falling
+/// back to a tiny ridge and then to an SVD pseudo-inverse. `None` when nothing works.
+pub(crate) fn spd_solve(h: &DMatrix<f64>, b: &DVector<f64>) -> Option<DVector<f64>> {
+    let n = h.nrows();
+    let d = jacobi_scale(h);
     let mut s = h.clone();
     for i in 0..n {
         for j in 0..n {

@@ -369,16 +369,7 @@ fn solve_many(s: &DMatrix<f64>, rhs: &DMatrix<f64>) -> Option<DMatrix<f64>> {
 /// variance comes out huge rather than wrongly small).
 pub(super) fn spd_inverse(h: &DMatrix<f64>) -> DMatrix<f64> {
     let n = h.nrows();
-    let d: Vec<f64> = (0..n)
-        .map(|i| {
-            let v = h[(i, i)];
-            if v > 0.0 && v.is_finite() {
-                1.0 / v.sqrt()
-            } else {
-                1.0
-            }
-        })
-        .collect();
+    let d = super::init::jacobi_scale(h);
     let s = DMatrix::from_fn(n, n, |i, j| h[(i, j)] * d[i] * d[j]);
     let inv = s
         .clone()

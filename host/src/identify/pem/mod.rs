@@ -22,6 +22,7 @@
 pub mod choose;
 pub mod focus;
 mod init;
+pub(crate) use init::jacobi_scale;
 pub mod offset;
 pub(crate) mod poly;
 pub(crate) mod sens;

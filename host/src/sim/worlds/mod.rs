@@ -53,7 +53,7 @@ use yawcast_shared::model::EffectKind;
 
 use super::dynamics::{self, Model};
 use super::inputs::{self, InputSpec, ZigZagLogic};
-use super::manoeuvres::ZigzagTracker;
+use super::manoeuvres::{TurningTracker, ZigzagTracker};
 use super::{NoiseSpec, Scenario, Ship, SimEffect, SimError, TurningResult, ZigzagResult};
 use crate::io::data::Record;
 
@@ -809,47 +809,21 @@ fn turning_hull(hull: &dyn Hull, delta_deg: f64) -> Result<TurningResult, SimErr
     }
     let (p, act, _) = Physics::new(hull, &[]);
     let sg = delta_deg.signum();
-    let mut prev: Option<(f64, f64, f64)> = None;
-    let (mut at90, mut at180) = (None, None);
-    let (mut r_sum, mut sp_sum, mut cnt) = (0.0, 0.0, 0usize);
-    let mut done = false;
+    let mut track = TurningTracker::new();
     run_hull(
         calm_run(hull, &p, act),
         |_, _| delta_deg,
         |_, s, _| {
-            let dpsi = sg * s[5].to_degrees();
-            let (x, y) = (s[3], sg * s[4]);
-            if let Some((pp, px, py)) = prev {
-                for (target, slot) in [(90.0, &mut at90), (180.0, &mut at180)] {
-                    if slot.is_none() && pp < target && dpsi >= target {
-                        let w = (target - pp) / (dpsi - pp);
-                        *slot = Some((px + w * (x - px), py + w * (y - py)));
-                    }
-                }
-            }
-            prev = Some((dpsi, x, y));
-            if (360.0..450.0).contains(&dpsi) {
-                r_sum += s[2].to_degrees();
-                sp_sum += p.sog(s);
-                cnt += 1;
-            }
-            done = dpsi >= 450.0;
-            !done
+            track.observe(
+                sg * s[5].to_degrees(),
+                s[3],
+                sg * s[4],
+                s[2].to_degrees(),
+                p.sog(s),
+            )
         },
     )?;
-    match (at90, at180, done && cnt > 0) {
-        (Some((adv, tr)), Some((_, td)), true) => Ok(TurningResult {
-            advance_m: adv,
-            transfer_m: tr,
-            tactical_diameter_m: td,
-            steady_r_degps: r_sum / cnt as f64,
-            steady_speed_mps: sp_sum / cnt as f64,
-        }),
-        _ => Err(SimError::Manoeuvre {
-            manoeuvre: "turning circle",
-            reason: format!("heading did not change by 450° at δ = {delta_deg}°"),
-        }),
-    }
+    track.result(delta_deg, "")
 }
 
 fn zigzag_hull(hull: &dyn Hull, delta_deg: f64, psi_deg: f64) -> Result<ZigzagResult, SimError> {
