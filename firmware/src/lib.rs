@@ -22,20 +22,16 @@
 //!
 //! [`Predictor::update_with_heading`]`(u, y, psi)`:
 //! 1. actuator: `δ = u(t−d)` (pop the delay line, push `u`; `δ = u` when `d = 0`);
-//!    `τ = clamp(δ, −limit, limit)` with saturation, else `τ = δ`;
-//!    with a dead band of width `b`, `τ = clamp(ũ_prev, τ − b, τ + b)` (`τ − b` and `τ + b`
-//!    each rounded first);
-//!    `ũ = ũ_prev + clamp(τ − ũ_prev, −s, s)` with a rate limit, where `s = rate · ts` is
-//!    computed once when the model is loaded, else `ũ = τ`; then `ũ_prev = ũ`.
-//!    `clamp(x, lo, hi)` is `lo` if `x < lo`, `hi` if `x > hi`, else `x`.
+//!    `ũ = Step::actuator(δ, ũ_prev)` of `yawcast_shared::kernel` (the angle limit, the dead
+//!    band and the largest move per step, each optional, in that order and evaluated as
+//!    documented there; the move per step is computed once when the model is loaded); then
+//!    `ũ_prev = ũ`.
 //! 2. heading: `ψ = psi` when given and finite, else `ψ̂`.
 //! 3. `ŷ = x̂_1 + d_y`; `y_used = y` if `y` is finite, else `ŷ`.
-//! 4. `v = ũ`, then for each effect present, in this order, `v = v + β·φ`:
-//!    bias `v = v + β`; asymmetry `φ = ũ` if `ũ > 0` else `+0`; nonlinear damping
-//!    `φ = y_used · |y_used|` or, cubic, `φ = (y_used · y_used) · y_used`; wind and current use
-//!    `r = ψ · (π/180)` (the constant rounded to `f32`), `(sin r, cos r) = libm::sincosf(r)`,
-//!    `(sin 2r, cos 2r) = libm::sincosf(r + r)`; wind adds `β_s2·sin 2r`, `β_c2·cos 2r`,
-//!    `β_s1·sin r`, `β_c1·cos r`, then current adds `β_s·sin r`, `β_c·cos r`, one term at a time.
+//! 4. `v = Step::effective_input(ũ, y_used, ψ)` of `yawcast_shared::kernel`: `v = ũ`, then
+//!    for each effect present, in library order, `v = v + β·φ` (bias, asymmetry, nonlinear
+//!    damping, then wind and current from `libm::sincosf` of `r = ψ·(π/180)` and of `r + r`),
+//!    one term at a time as documented there.
 //! 5. `e = y − ŷ` if `y` is finite; otherwise there is no correction
 //!    ([`UpdateStatus::SkippedCorrection`]) and `e = 0`.
 //! 6. with `s = (…((a_1·x̂_1 + a_2·x̂_2) + a_3·x̂_3) …) + a_N·x̂_N` (the model is in the
@@ -60,7 +56,8 @@
 // `v = v + β·φ` is written out so the code reads exactly like the documented evaluation order.
 #![allow(clippy::assign_op_pattern)]
 
-use yawcast_shared::model::{Effect, ModelError, ModelSpec, MAX_DEAD_TIME, MAX_ORDER, MIN_ORDER};
+use yawcast_shared::kernel::Step;
+use yawcast_shared::model::{ModelError, ModelSpec, MAX_DEAD_TIME, MAX_ORDER, MIN_ORDER};
 
 /// Longest prediction horizon [`Predictor::predict_into`] accepts.
 pub const MAX_HORIZON: usize = 64;
@@ -68,9 +65,6 @@ pub const MAX_HORIZON: usize = 64;
 /// Length of the dead-time delay line (a power of two, so index masking cannot fail).
 const DELAY_LEN: usize = MAX_DEAD_TIME as usize;
 const _: () = assert!(DELAY_LEN.is_power_of_two());
-
-/// Degrees to radians, rounded once to `f32`.
-const DEG2RAD: f32 = core::f32::consts::PI / 180.0;
 
 /// What one [`Predictor::update`] did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -180,31 +174,11 @@ pub struct Predictor<const N: usize = 4> {
     ts: f32,
     /// No effect at all: the specialised path.
     plain: bool,
-    dy: Option<f32>,
-    dead: u8,
-    limit: Option<f32>,
-    band: Option<f32>,
-    rate_step: Option<f32>,
-    bias: Option<f32>,
-    asym: Option<f32>,
-    damp: Option<(f32, bool)>,
-    wind: Option<[f32; 4]>,
-    current: Option<[f32; 2]>,
+    /// The effects, unpacked (`yawcast_shared::kernel`).
+    fx: Step<f32>,
     /// Wind or current: the heading is tracked (steps 2 and 7).
     heading: bool,
     st: PredictorState<N>,
-}
-
-/// `lo` if `x < lo`, `hi` if `x > hi`, else `x` (NaN passes through). Never panics.
-#[inline(always)]
-fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
-    if x < lo {
-        lo
-    } else if x > hi {
-        hi
-    } else {
-        x
-    }
 }
 
 impl<const N: usize> Predictor<N> {
@@ -245,42 +219,14 @@ impl<const N: usize> Predictor<N> {
             k: [0.0; N],
             ts: spec.ts,
             plain: spec.effects.is_empty(),
-            dy: None,
-            dead: 0,
-            limit: None,
-            band: None,
-            rate_step: None,
-            bias: None,
-            asym: None,
-            damp: None,
-            wind: None,
-            current: None,
+            fx: Step::new(&spec.effects, spec.ts),
             heading: false,
             st: PredictorState::ZERO,
         };
         p.a.copy_from_slice(&spec.a[..N]);
         p.b.copy_from_slice(&spec.b[..N]);
         p.k.copy_from_slice(&spec.k[..N]);
-        for e in &spec.effects {
-            match *e {
-                Effect::Bias { beta } => p.bias = Some(beta),
-                Effect::GyroBias { d_y } => p.dy = Some(d_y),
-                Effect::DeadTime { samples } => p.dead = samples,
-                Effect::RateLimit { rate } => p.rate_step = Some(rate * spec.ts),
-                Effect::Saturation { limit } => p.limit = Some(limit),
-                Effect::Asymmetry { beta } => p.asym = Some(beta),
-                Effect::NonlinearDamping { beta, cubic } => p.damp = Some((beta, cubic)),
-                Effect::Wind {
-                    beta_s2,
-                    beta_c2,
-                    beta_s1,
-                    beta_c1,
-                } => p.wind = Some([beta_s2, beta_c2, beta_s1, beta_c1]),
-                Effect::Current { beta_s, beta_c } => p.current = Some([beta_s, beta_c]),
-                Effect::DeadBand { width } => p.band = Some(width),
-            }
-        }
-        p.heading = p.wind.is_some() || p.current.is_some();
+        p.heading = p.fx.heading();
         Ok(p)
     }
 
@@ -446,7 +392,7 @@ impl<const N: usize> Predictor<N> {
     /// `x̂_1 + d_y` of a state (`x̂_1` without gyro bias).
     #[inline(always)]
     fn output(&self, st: &PredictorState<N>) -> f32 {
-        match self.dy {
+        match self.fx.dy {
             Some(dy) => st.x[0] + dy,
             None => st.x[0],
         }
@@ -455,37 +401,26 @@ impl<const N: usize> Predictor<N> {
     /// `y − d_y` (`y` without gyro bias).
     #[inline(always)]
     fn minus_dy(&self, y: f32) -> f32 {
-        match self.dy {
+        match self.fx.dy {
             Some(dy) => y - dy,
             None => y,
         }
     }
 
-    /// The actuator chain: dead time, saturation, dead band, rate limit. Advances its state.
+    /// The actuator chain: the dead time here, the rest in the kernel. Advances its state.
     #[inline(always)]
     fn actuator(&self, st: &mut PredictorState<N>, u: f32) -> f32 {
-        let delayed = if self.dead > 0 {
+        let delayed = if self.fx.dead > 0 {
             let h = usize::from(st.delay_head) % DELAY_LEN;
             let out = st.delay[h];
             st.delay[h] = u;
             let next = st.delay_head + 1;
-            st.delay_head = if next >= self.dead { 0 } else { next };
+            st.delay_head = if next >= self.fx.dead { 0 } else { next };
             out
         } else {
             u
         };
-        let target = match self.limit {
-            Some(l) => clamp(delayed, -l, l),
-            None => delayed,
-        };
-        let target = match self.band {
-            Some(b) => clamp(st.u_prev, target - b, target + b),
-            None => target,
-        };
-        let ut = match self.rate_step {
-            Some(s) => st.u_prev + clamp(target - st.u_prev, -s, s),
-            None => target,
-        };
+        let ut = self.fx.actuator(delayed, st.u_prev);
         st.u_prev = ut;
         ut
     }
@@ -493,38 +428,7 @@ impl<const N: usize> Predictor<N> {
     /// `v = ũ + Σ β φ`, accumulated one term at a time in library order.
     #[inline(always)]
     fn effective_input(&self, ut: f32, y_used: f32, psi: f32) -> f32 {
-        let mut v = ut;
-        if let Some(beta) = self.bias {
-            v = v + beta;
-        }
-        if let Some(beta) = self.asym {
-            let phi = if ut > 0.0 { ut } else { 0.0 };
-            v = v + beta * phi;
-        }
-        if let Some((beta, cubic)) = self.damp {
-            let phi = if cubic {
-                y_used * y_used * y_used
-            } else {
-                y_used * libm::fabsf(y_used)
-            };
-            v = v + beta * phi;
-        }
-        if self.wind.is_some() || self.current.is_some() {
-            let r = psi * DEG2RAD;
-            let (s1, c1) = libm::sincosf(r);
-            if let Some(w) = self.wind {
-                let (s2, c2) = libm::sincosf(r + r);
-                v = v + w[0] * s2;
-                v = v + w[1] * c2;
-                v = v + w[2] * s1;
-                v = v + w[3] * c1;
-            }
-            if let Some(c) = self.current {
-                v = v + c[0] * s1;
-                v = v + c[1] * c1;
-            }
-        }
-        v
+        self.fx.effective_input(ut, y_used, psi)
     }
 
     /// Predicts `out.len()` = H outputs ŷ(t+1|t) … ŷ(t+H|t) from the current state, with
@@ -692,11 +596,11 @@ impl<const N: usize> Predictor<N> {
     /// # Ok::<(), PredictorError>(())
     /// ```
     pub fn restore(&mut self, state: PredictorState<N>) -> Result<(), PredictorError> {
-        let d = usize::from(self.dead);
+        let d = usize::from(self.fx.dead);
         let head_ok = if d == 0 {
             state.delay_head == 0
         } else {
-            state.delay_head < self.dead
+            state.delay_head < self.fx.dead
         };
         let finite = state.x.iter().all(|v| v.is_finite())
             && state.delay.iter().take(d).all(|v| v.is_finite())

@@ -9,6 +9,7 @@
 
 pub mod demo;
 pub mod diagnose;
+pub mod effects;
 pub mod identify;
 pub mod io;
 mod par;

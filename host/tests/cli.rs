@@ -938,7 +938,7 @@ fn augment_auto_on_a_slow_gear_reference_names_and_keeps_a_slower_slew_limit() {
     use yawcast_shared::model::EffectKind;
     let d = scratch("slowgear");
     let mut ship = Ship::default_lng();
-    ship.actuator.slew_degps = 4.0;
+    ship.actuator.max_rate_degps = 4.0;
     ship.actuator.servo_tau_s = 2.5;
     let write = |name: &str, effect: Option<SimEffect>, seeds: &[u64]| -> Vec<PathBuf> {
         let sc = Scenario {
@@ -1093,6 +1093,7 @@ fn augment_adds_a_dead_time_exports_it_and_writes_the_ship() {
     assert!(v["delta_aic"].as_f64().unwrap() < 0.0);
     assert!(v["delta_bic"].as_f64().unwrap() < 0.0);
     assert!(v["explanation"].as_str().unwrap().contains("Kept"));
+    assert_eq!(v["reasons"], serde_json::json!([]));
     assert_eq!(v["ship"], s(&ship));
     assert!(v["more"].is_null(), "{}", v["more"]);
     assert_eq!(v["effects"], serde_json::json!(["dead-time"]));

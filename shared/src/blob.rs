@@ -205,7 +205,7 @@ pub fn decode_blob(bytes: &[u8]) -> Result<ModelSpec, BlobError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{Effect, Units, MAX_ORDER};
+    use crate::model::{Units, EVERY_EFFECT, MAX_ORDER};
 
     fn full_model() -> ModelSpec {
         // order 8 with every effect: the largest payload there is. (δ + 0.5)⁸: eight poles
@@ -222,38 +222,7 @@ mod tests {
         ];
         let mut k = [0.0f32; MAX_ORDER];
         k[0] = 0.1;
-        ModelSpec::new(
-            8,
-            0.5,
-            &a,
-            &[0.1; 8],
-            &k,
-            Units::default(),
-            &[
-                Effect::Bias { beta: 0.1 },
-                Effect::GyroBias { d_y: 0.1 },
-                Effect::DeadTime { samples: 3 },
-                Effect::RateLimit { rate: 5.0 },
-                Effect::Saturation { limit: 35.0 },
-                Effect::Asymmetry { beta: 0.1 },
-                Effect::NonlinearDamping {
-                    beta: 0.1,
-                    cubic: true,
-                },
-                Effect::Wind {
-                    beta_s2: 0.1,
-                    beta_c2: 0.1,
-                    beta_s1: 0.1,
-                    beta_c1: 0.1,
-                },
-                Effect::Current {
-                    beta_s: 0.1,
-                    beta_c: 0.1,
-                },
-                Effect::DeadBand { width: 1.0 },
-            ],
-        )
-        .unwrap()
+        ModelSpec::new(8, 0.5, &a, &[0.1; 8], &k, Units::default(), &EVERY_EFFECT).unwrap()
     }
 
     #[test]

@@ -10,6 +10,7 @@ extern crate std;
 
 pub mod blob;
 pub mod crc;
+pub mod kernel;
 pub mod model;
 pub mod wire;
 

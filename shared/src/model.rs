@@ -90,16 +90,16 @@ impl Default for Units {
 /// Not `#[non_exhaustive]`: every match over the library is exhaustive, so a new effect makes
 /// the compiler list each place that must learn it (the blob's format version guards the wire).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum Effect {
+pub enum Effect<R = f32> {
     /// Constant yaw moment (current, steady wind, propeller asymmetry): `φ = 1` through B.
     Bias {
         /// Gain β (input units).
-        beta: f32,
+        beta: R,
     },
     /// Rate-sensor offset: `y = x_1 + d_y`.
     GyroBias {
         /// Output offset `d_y` (output units).
-        d_y: f32,
+        d_y: R,
     },
     /// Actuator/command delay: `ũ(t) = u(t − d)`.
     DeadTime {
@@ -109,22 +109,22 @@ pub enum Effect {
     /// Pod/rudder slew limit: `ũ` follows its target at no more than `ρ·Ts` per step.
     RateLimit {
         /// Slew rate ρ in input units per second, `> 0`.
-        rate: f32,
+        rate: R,
     },
     /// Angle limit: `ũ = clamp(ũ, −δ_max, δ_max)`.
     Saturation {
         /// Limit δ_max in input units, `> 0`.
-        limit: f32,
+        limit: R,
     },
     /// Port/starboard gain difference: `φ = max(ũ, 0)` through B.
     Asymmetry {
         /// Gain β.
-        beta: f32,
+        beta: R,
     },
     /// Hull damping beyond linear (Norrbin): `φ = y|y|` (or `y³`) through B.
     NonlinearDamping {
         /// Gain β.
-        beta: f32,
+        beta: R,
         /// `true` for `φ = y³`, `false` for `φ = y|y|`.
         cubic: bool,
     },
@@ -132,20 +132,20 @@ pub enum Effect {
     /// `φ = (sin 2ψ, cos 2ψ, sin ψ, cos ψ)` through B.
     Wind {
         /// Gain of `sin 2ψ`.
-        beta_s2: f32,
+        beta_s2: R,
         /// Gain of `cos 2ψ`.
-        beta_c2: f32,
+        beta_c2: R,
         /// Gain of `sin ψ`.
-        beta_s1: f32,
+        beta_s1: R,
         /// Gain of `cos ψ`.
-        beta_c1: f32,
+        beta_c1: R,
     },
     /// Heading-dependent drift moment of a current: `φ = (sin ψ, cos ψ)` through B.
     Current {
         /// Gain of `sin ψ`.
-        beta_s: f32,
+        beta_s: R,
         /// Gain of `cos ψ`.
-        beta_c: f32,
+        beta_c: R,
     },
     /// Steering-gear dead band (backlash, a worn gear): the rudder/pod does not move until
     /// the (saturated) command differs from its position by more than `width`, then follows
@@ -155,7 +155,7 @@ pub enum Effect {
     /// of format 2 blobs written before it existed.
     DeadBand {
         /// Width b in input units, `> 0`.
-        width: f32,
+        width: R,
     },
 }
 
@@ -276,7 +276,7 @@ impl EffectKind {
     }
 }
 
-impl Effect {
+impl<R> Effect<R> {
     /// The kind of this effect.
     ///
     /// ```
@@ -298,6 +298,37 @@ impl Effect {
         }
     }
 }
+
+/// One effect of every kind with typical parameters, in library order
+/// ([`EffectKind::ALL`]): for examples and tests that must cover the whole library.
+///
+/// ```
+/// use yawcast_shared::model::{EffectKind, EVERY_EFFECT};
+/// assert!(EVERY_EFFECT.iter().map(|e| e.kind()).eq(EffectKind::ALL));
+/// ```
+pub const EVERY_EFFECT: [Effect; EffectKind::ALL.len()] = [
+    Effect::Bias { beta: 0.2 },
+    Effect::GyroBias { d_y: -0.3 },
+    Effect::DeadTime { samples: 3 },
+    Effect::RateLimit { rate: 4.0 },
+    Effect::Saturation { limit: 6.0 },
+    Effect::Asymmetry { beta: 0.1 },
+    Effect::NonlinearDamping {
+        beta: -0.05,
+        cubic: false,
+    },
+    Effect::Wind {
+        beta_s2: 0.3,
+        beta_c2: -0.2,
+        beta_s1: 0.1,
+        beta_c1: 0.05,
+    },
+    Effect::Current {
+        beta_s: -0.2,
+        beta_c: 0.1,
+    },
+    Effect::DeadBand { width: 0.75 },
+];
 
 /// A complete model as exported to the controller (all numbers `f32`), in the difference
 /// form (module docs).
@@ -738,3 +769,13 @@ fn monic_schur_stable(poly: &Poly, n: usize) -> bool {
 
 #[cfg(test)]
 mod tests;
+
+/// The rate of a slow gear must be positive (the other parameters' checks are in the tests
+/// module).
+#[cfg(test)]
+#[test]
+fn gear_rate_must_be_positive() {
+    let ok = |rate: f32| effect_ok(&Effect::RateLimit { rate });
+    assert!(ok(2.0));
+    assert!(!ok(0.0) && !ok(-1.0) && !ok(f32::NAN) && !ok(2.0e6));
+}

@@ -22,9 +22,9 @@ pub struct AugmentArgs {
     /// The model to augment (`.postcard` blob with its `.json` twin, or the `.json` twin).
     #[arg(long, value_name = "FILE")]
     pub model: PathBuf,
-    /// The effect to add (bias, gyro-bias, dead-time, rate-limit, saturation, asymmetry,
-    /// nonlinear-damping, wind, current, dead-band), `auto` for the verdict of `yawcast diagnose`, or
-    /// `none` (with `--more`: only the search).
+    /// The effect to add, by its library name (docs/formats.md; a wrong name lists them),
+    /// `auto` for the verdict of `yawcast diagnose`, or `none` (with `--more`: only the
+    /// search).
     #[arg(long, value_name = "NAME")]
     pub effect: String,
     /// Then search the effects library: add further effects one at a time, each only while
@@ -100,6 +100,8 @@ pub struct AugmentSummary {
     pub estimated: Option<yawcast::identify::model::Effect>,
     /// STD% of the augmented model's parameters.
     pub std_pct: Vec<f64>,
+    /// Why the effect is not kept, typed (`{"reason": "within-spread", …}`); empty when kept.
+    pub reasons: Vec<augment::Reason>,
     /// Physical words with numbers.
     pub explanation: String,
     /// The model blob written.
@@ -262,7 +264,12 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
             let (kind, gear) = choose_auto(&given, &reference, &est, &val, seed, args.null_reps)?;
             let model = match gear {
                 Some(g) => {
-                    with_reference_gear(&given, g, kind, if val.is_empty() { &est } else { &val })
+                    let check = if val.is_empty() { &est } else { &val };
+                    let (m, why) = augment::gear_base(&given, g, kind, check);
+                    if let Some(w) = why.explain(given.ts) {
+                        println!("{w}");
+                    }
+                    m
                 }
                 None => given.clone(),
             };
@@ -338,6 +345,7 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
             ljung_box_p_after: rep.ljung_box_p_after,
             estimated: rep.candidate.effect(kind).copied(),
             std_pct: rep.std_pct.clone(),
+            reasons: rep.reasons.clone(),
             explanation: rep.explanation.clone(),
             out: ex.blob_path,
             ship: ship_written,
@@ -473,53 +481,6 @@ fn written_kind(given: &Model, written: &Model) -> Written {
     } else {
         Written::Refit
     }
-}
-
-/// `--effect auto` found steering-gear dynamics the reference records show of their own
-/// (`gear`: the reference model with them, re-identified on the reference): they are part of
-/// the reference, so the trials are augmented from that model — when it predicts the trial
-/// records `check` at 10 steps at least as well as the model given. When the verdict is of
-/// the same kind (a slower slew limit on the trials than the reference's own), the trials'
-/// value is estimated from the model given, as without a gear.
-fn with_reference_gear(
-    given: &Model,
-    gear: Model,
-    verdict: Option<EffectKind>,
-    check: &[Record],
-) -> Model {
-    if verdict.is_some_and(|k| gear.effect(k).is_some()) {
-        return given.clone();
-    }
-    let fit10 = |m: &Model| {
-        yawcast::identify::merge::validation_fits(m, check)
-            .get("10")
-            .copied()
-            .unwrap_or(f64::NAN)
-    };
-    let (fg, fm) = (fit10(&gear), fit10(given));
-    if fg.is_nan() || fg < fm {
-        println!(
-            "the reference's own steering gear is left out: the reference model with it \
-             predicts the trials worse at 10 steps ({fg:.2} < {fm:.2} %)"
-        );
-        return given.clone();
-    }
-    let m = gear;
-    let own: Vec<String> = m
-        .effects
-        .iter()
-        .filter(|e| given.effect(e.kind()).is_none())
-        .map(|e| augment::describe(e, m.ts))
-        .collect();
-    if own.is_empty() {
-        return given.clone();
-    }
-    println!(
-        "augmenting the reference model with the steering-gear dynamics the reference records \
-         show of their own: {}",
-        own.join(", ")
-    );
-    m
 }
 
 /// The note after "model written to …".

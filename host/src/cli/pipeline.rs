@@ -397,11 +397,10 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
 /// Identification errors caused by the data are bad input; a search that found no stable
 /// model is a failure.
 fn input_ident(e: pem::IdentError) -> anyhow::Error {
-    let msg = e.to_string();
-    if msg.contains("start") && msg.contains("stable") {
-        anyhow::Error::new(e)
+    if e.is_bad_input() {
+        bad(e.to_string())
     } else {
-        bad(msg)
+        anyhow::Error::new(e)
     }
 }
 

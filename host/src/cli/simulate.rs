@@ -30,8 +30,8 @@ pub struct SimulateArgs {
     /// times by √(L/320); the default Ts too).
     #[arg(long, value_name = "L_M")]
     pub scale: Option<f64>,
-    /// Switch on a library effect at its canonical strength (repeatable): bias, gyro-bias,
-    /// dead-time, rate-limit, saturation, asymmetry, nonlinear-damping, wind, current, dead-band.
+    /// Switch on a library effect, by its name (docs/formats.md; a wrong name lists them),
+    /// at its canonical strength (repeatable).
     #[arg(long, value_name = "NAME")]
     pub effect: Vec<String>,
     /// Strength of the `--effect`s (1 full, 0.5 half).

@@ -9,6 +9,7 @@ use yawcast_shared::model::EffectKind;
 
 use super::verdict::{cfg_m, Evidence};
 use super::{heading_bias, DiagnoseConfig};
+use crate::effects::{def, Channel};
 use crate::io::data::Record;
 use crate::stats::{chi2_sf, normal_sf};
 
@@ -238,8 +239,8 @@ pub(super) fn add_channels(
 ) {
     let kind = ev.kind;
     let p_yaw = ev.p_yaw;
-    match kind {
-        EffectKind::GyroBias => {
+    match def(kind).channel {
+        Channel::Heading => {
             if let Some((b, se)) = hb {
                 let z = b / se;
                 ev.p = (2.0 * normal_sf(z.abs())).min(1.0);
@@ -258,7 +259,7 @@ pub(super) fn add_channels(
                 );
             }
         }
-        EffectKind::Current | EffectKind::Wind => {
+        Channel::SpeedOverGround => {
             if let Some(s) = sog {
                 let (chi, df) = if kind == EffectKind::Current {
                     (s.chi1, 2.0)
@@ -287,12 +288,6 @@ pub(super) fn add_channels(
             }
         }
         // the channels carry nothing of the actuator and hull effects, nor of a moment
-        EffectKind::Bias
-        | EffectKind::DeadTime
-        | EffectKind::RateLimit
-        | EffectKind::Saturation
-        | EffectKind::DeadBand
-        | EffectKind::Asymmetry
-        | EffectKind::NonlinearDamping => {}
+        Channel::None => {}
     }
 }

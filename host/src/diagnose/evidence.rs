@@ -6,6 +6,7 @@ use nalgebra::{DMatrix, DVector};
 use yawcast_shared::model::EffectKind;
 
 use super::SLOW_HORIZON;
+use crate::effects::{def, GridSpan};
 use crate::identify::model::{Effect, Model};
 use crate::identify::predict::{self, Stepper};
 use crate::io::data::Record;
@@ -14,16 +15,10 @@ use crate::io::data::Record;
 const SLOW_STRIDE: usize = 10;
 
 pub(super) fn horizon_of(kind: EffectKind) -> usize {
-    match kind {
-        EffectKind::Bias | EffectKind::GyroBias | EffectKind::Wind | EffectKind::Current => {
-            SLOW_HORIZON
-        }
-        EffectKind::DeadTime
-        | EffectKind::RateLimit
-        | EffectKind::Saturation
-        | EffectKind::DeadBand
-        | EffectKind::Asymmetry
-        | EffectKind::NonlinearDamping => 1,
+    if def(kind).slow {
+        SLOW_HORIZON
+    } else {
+        1
     }
 }
 
@@ -174,73 +169,10 @@ fn quad_multi(model: &Model, cands: &[Effect], rec: &Record, x0: &[f64], h: usiz
     q
 }
 
-/// The candidates (grid) of one effect kind, with zero gains.
-pub(super) fn grid(kind: EffectKind, ts: f64, u_max: f64, du_max: f64) -> Vec<Effect> {
-    match kind {
-        EffectKind::DeadTime => {
-            let dmax = ((8.0 / ts).ceil() as usize).clamp(1, 20);
-            (1..=dmax)
-                .map(|d| Effect::DeadTime { samples: d })
-                .collect()
-        }
-        EffectKind::RateLimit => {
-            // slew rates that bind on the recorded commands: from 0.5 °/s to the largest
-            // command step, geometric
-            let hi = (du_max / ts).max(1.0);
-            let lo = 0.5_f64.min(hi / 2.0);
-            geometric(lo, hi * 0.9, 12)
-                .into_iter()
-                .map(|rate| Effect::RateLimit { rate })
-                .collect()
-        }
-        EffectKind::Saturation => geometric(0.2 * u_max, 0.95 * u_max, 12)
-            .into_iter()
-            .map(|limit| Effect::Saturation { limit })
-            .collect(),
-        EffectKind::DeadBand => band_widths(u_max)
-            .into_iter()
-            .map(|width| Effect::DeadBand { width })
-            .collect(),
-        EffectKind::NonlinearDamping => vec![
-            Effect::NonlinearDamping {
-                beta: 0.0,
-                cubic: false,
-            },
-            Effect::NonlinearDamping {
-                beta: 0.0,
-                cubic: true,
-            },
-        ],
-        // one structure each, the gains to be fitted
-        EffectKind::Bias
-        | EffectKind::GyroBias
-        | EffectKind::Asymmetry
-        | EffectKind::Wind
-        | EffectKind::Current => vec![Effect::zero(kind, 0.0)],
-    }
-}
-
-/// The dead-band widths searched, by diagnose and by augment alike: 12 geometric steps from
-/// 0.2° to 6° (worn steering gears show 0.5–3°), or to 40 % of the largest command when that
-/// is smaller. A wider "band" on large-amplitude records (zig-zags) only trades the command's
-/// amplitude against the model's gain, so it is not searched.
-///
-/// ```
-/// let w = yawcast::diagnose::band_widths(20.0);
-/// assert_eq!(w.len(), 12);
-/// assert!((w[0] - 0.2).abs() < 1e-12 && (w[11] - 6.0).abs() < 1e-9);
-/// assert!((yawcast::diagnose::band_widths(5.0)[11] - 2.0).abs() < 1e-9);
-/// ```
-pub fn band_widths(u_max: f64) -> Vec<f64> {
-    geometric(0.2, 6.0_f64.min(0.4 * u_max), 12)
-}
-
-fn geometric(lo: f64, hi: f64, n: usize) -> Vec<f64> {
-    if !(lo > 0.0 && hi > lo) {
-        return vec![hi.max(1e-6)];
-    }
-    let r = (hi / lo).powf(1.0 / (n - 1) as f64);
-    (0..n).map(|i| lo * r.powi(i as i32)).collect()
+/// The candidates (grid) of one effect kind, with zero gains: the effect's own
+/// ([`crate::effects::Def::candidates`]) over the records' span.
+pub(super) fn grid(kind: EffectKind, span: &GridSpan) -> Vec<Effect> {
+    (def(kind).candidates)(span)
 }
 
 /// A set of records with the base model's x̂(0) per record.

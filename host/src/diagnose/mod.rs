@@ -5,7 +5,7 @@
 //! The method (for users, in words: docs/method.md, "Diagnose and augment"):
 //!
 //! - **Frozen linear part.** θ stays at the model's values; each effect is added with its
-//!   structural parameter on a grid (dead time d, slew rate ρ, clip level, `y|y|` or `y³`)
+//!   structural parameter on a grid (dead time d, gear rate ρ, clip level, `y|y|` or `y³`)
 //!   and its linear gains fitted by least squares on the prediction errors (one-step errors
 //!   for actuator and hull effects, ≈ 50-step errors for the slow effects bias, gyro bias,
 //!   wind and current). The likelihood statistic is `N·ln(SSE₀/SSE₁)`, maximised over the grid.
@@ -13,14 +13,14 @@
 //!   version of the effect the reference already shows (a linear model of a nonlinear hull
 //!   shows "nonlinear damping" on any data). The trial statistic is measured from that
 //!   version: `D = N·ln(SSE(reference version)/SSE(trial's best))`.
-//! - **The reference's own steering gear.** A slow or delayed gear (a slew limit, a dead
-//!   time) is dynamics: the linear model identified on the reference absorbs it into its
+//! - **The reference's own steering gear.** A slow or delayed gear (a low rudder rate, a
+//!   dead time) is dynamics: the linear model identified on the reference absorbs it into its
 //!   poles, so with θ frozen the reference shows no version of it, and on the trials
 //!   whichever gear effect mimics the gear's lag best on their commands stands out — a
-//!   2 s dead time on a ship whose own gear slews at 4 °/s looked like a slew limit of
-//!   5 °/s, and trials with no hidden effect showed a slew limit. So first the reference's
+//!   2 s dead time on a ship whose own gear turns at 4 °/s looked like a gear of
+//!   5 °/s, and trials with no hidden effect showed a slow gear. So first the reference's
 //!   own gear dynamics are looked for with θ re-identified ([`crate::diagnose::augment::forward`] over
-//!   dead time and slew limit on the reference records, its rule for keeping an effect);
+//!   the gear dynamics effects on the reference records, its rule for keeping an effect);
 //!   when the reference shows some, every statistic below is measured against the reference
 //!   model with it (`base`), and a trial's departure from the reference's gear is tested as
 //!   that effect's parameter moving. Angle limits are left to the frozen reference version:
@@ -42,7 +42,7 @@
 //!   slow disturbances are accounted for.
 //! - **Encompassing test between the top two**: both effects fitted jointly, each over its
 //!   whole grid; what each adds given the other, beyond the version the reference shows,
-//!   decides between look-alikes (dead time vs slew limit, bias vs current vs wind).
+//!   decides between look-alikes (dead time vs a slow gear, bias vs current vs wind).
 //! - **Ranking.** Effects are ranked by their likelihood gain above noise (`D` less its null
 //!   mean; a channel's χ² less its degrees of freedom): p-values far in the tail rest on the
 //!   shape fitted to a few dozen null replicates and cannot be compared between effects.
@@ -75,7 +75,7 @@ mod null;
 mod reference;
 pub mod resid;
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
 mod verdict;
 mod window;
 
@@ -87,6 +87,7 @@ use yawcast_shared::model::EffectKind;
 
 use crate::diagnose::augment::{AugmentConfig, AugmentReport};
 use crate::diagnose::compare::{check_inputs, mean_fit, InputError};
+use crate::effects::GridSpan;
 use crate::identify::model::{Effect, Model};
 use crate::identify::predict::Horizon;
 use crate::io::data::Record;
@@ -100,7 +101,6 @@ use verdict::{
 };
 
 pub use crate::io::data::{heading_bias, HeadingBias};
-pub use evidence::band_widths;
 pub use verdict::effect_phrase;
 pub use window::{window, WINDOW, WINDOW_BLOCK};
 
@@ -189,7 +189,7 @@ pub struct Ranked {
     /// Held-out improvement on refit, or measurable channel evidence.
     pub material: bool,
     /// The effect's estimated structural parameter in physical units, where it has one
-    /// (dead time s, slew °/s, clip level °, gyro bias °/s, current m/s of speed over ground).
+    /// (dead time s, gear rate °/s, clip level °, gyro bias °/s, current m/s of speed over ground).
     pub parameter: Option<f64>,
     /// The evidence in words.
     pub evidence: String,
@@ -302,14 +302,8 @@ pub fn diagnose(
     let base = gear.as_ref().map_or(model, |g| &g.model);
     let trial = Set::new(model, est);
     let refset = Set::from_owned(model, reference);
-    let all = est.iter().chain(reference);
-    let u_max = all
-        .clone()
-        .flat_map(|r| r.u.iter())
-        .fold(0.0_f64, |a, b| a.max(b.abs()));
-    let du_max = all
-        .flat_map(|r| r.u.windows(2).map(|w| (w[1] - w[0]).abs()))
-        .fold(0.0_f64, f64::max);
+    let span = GridSpan::of(model.ts, est.iter().chain(reference).map(|r| &r.u[..]));
+    let u_max = span.u_max;
     // innovation std under the null: the model's one-step errors on the reference (or trial)
     let sig_set = if has_ref { &refset } else { &trial };
     let (s1, n1) = sig_set.sse0(model, 1);
@@ -342,10 +336,8 @@ pub fn diagnose(
 
     let ch = Channels::measure(est, reference, cfg.seed);
 
-    let grids: Vec<(EffectKind, Vec<Effect>)> = kinds
-        .iter()
-        .map(|&k| (k, grid(k, model.ts, u_max, du_max)))
-        .collect();
+    let grids: Vec<(EffectKind, Vec<Effect>)> =
+        kinds.iter().map(|&k| (k, grid(k, &span))).collect();
     let real = world(base, reference, est, &grids, cfg.parallel);
     bar.inc(1);
     bar.set_message("bootstrap replicates");

@@ -6,18 +6,11 @@ use yawcast_shared::model::EffectKind;
 
 use super::evidence::Set;
 use super::DiagnoseConfig;
+use crate::effects::{def, Role};
 use crate::identify::model::Model;
 use crate::identify::pem::{self, PemConfig};
 use crate::io::data::Record;
 use crate::stats::chi2_sf;
-
-/// The actuator effects that are gear *dynamics*: a slow or delayed gear changes when the
-/// rudder/pod angle arrives, which a linear model absorbs into its poles (a lag), so with θ
-/// frozen the reference shows neither. An angle limit is static: θ cannot absorb it (it
-/// changes the gain at large angles, not the dynamics), so the frozen reference version
-/// already holds it — and on a hull whose turning rate grows less than linearly with the
-/// rudder angle a re-identified angle limit would stand for that hull physics instead.
-const GEAR_DYNAMICS: [EffectKind; 2] = [EffectKind::DeadTime, EffectKind::RateLimit];
 
 /// The actuator physics the reference records show of their own: the reference model with
 /// it, θ re-identified on the reference, and the explanation's sentence.
@@ -39,7 +32,14 @@ pub(super) fn reference_actuator(
     let kinds: Vec<EffectKind> = EffectKind::ALL
         .iter()
         .copied()
-        .filter(|k| GEAR_DYNAMICS.contains(k) && model.effect(*k).is_none())
+        // the gear *dynamics* ([`Role::Actuator`]): a slow or delayed gear changes when the
+        // rudder/pod angle arrives, which a linear model absorbs into its poles (a lag), so
+        // with θ frozen the reference shows neither. A static limit or band θ cannot absorb,
+        // so the frozen reference version already holds it — and on a hull whose turning
+        // rate grows less than linearly with the rudder angle a re-identified angle limit
+        // would stand for that hull physics instead.
+        .filter(|k| def(*k).role == Role::Actuator { dynamics: true })
+        .filter(|k| model.effect(*k).is_none())
         .collect();
     if kinds.is_empty() {
         return None;
@@ -71,7 +71,7 @@ pub(super) fn reference_actuator(
 }
 
 /// Is the model fitted to the trials rather than the reference? Then it has absorbed what
-/// the trials show — a slew or angle limit above all — and the statistics against the
+/// the trials show — a slow gear or an angle limit above all — and the statistics against the
 /// reference lose their power. Said when the model is significantly worse on the reference
 /// than the same structure re-identified there (likelihood ratio; ≈ 0 for the reference's
 /// own model) *and* predicts the trials better than that re-identified model does. On

@@ -86,85 +86,12 @@ pub(super) fn effect_evidence(
 }
 
 /// The yaw channel's evidence of `ev.best` in words (`pct`: the share of the error energy
-/// it removes), with the effect's structural parameter in physical units.
+/// it removes), with the effect's structural parameter in physical units (the effect's own
+/// sentence, [`Effect::evidence`]).
 fn yaw_words(ev: &mut Evidence, ts: f64, pct: f64) {
-    let best = ev.best;
-    let p_yaw = ev.p_yaw;
-    match best {
-        Effect::DeadTime { samples } => {
-            let s = samples as f64 * ts;
-            ev.parameter = Some(s);
-            ev.words = format!(
-                "errors follow the steering commands late; a dead time of {s:.1} s removes {pct:.0} % of \
-                 the one-step error energy the reference version leaves"
-            );
-        }
-        Effect::RateLimit { rate } => {
-            ev.parameter = Some(rate);
-            ev.words = format!(
-                "errors grow right after fast steering reversals; a slew limit of {rate:.1} °/s explains \
-                 {pct:.0} % of the one-step error energy"
-            );
-        }
-        Effect::Saturation { limit } => {
-            ev.parameter = Some(limit);
-            ev.words = format!(
-                "large rudder/pod angles turn the ship less than the model expects; an angle limit of \
-                 {limit:.1}° explains {pct:.0} % of the one-step error energy"
-            );
-        }
-        Effect::DeadBand { width } => {
-            ev.parameter = Some(width);
-            ev.words = format!(
-                "small steering corrections do not reach the ship and reversals arrive short; a \
-                 dead band of {width:.2}° explains {pct:.0} % of the one-step error energy"
-            );
-        }
-        Effect::Asymmetry { beta } => {
-            ev.parameter = Some(beta);
-            ev.words = format!(
-                "starboard commands act {} than port ones (gain {beta:+.3} on max(δ,0)); explains \
-                 {pct:.0} % of the one-step error energy",
-                if beta > 0.0 { "harder" } else { "softer" }
-            );
-        }
-        Effect::NonlinearDamping { beta, cubic } => {
-            ev.parameter = Some(beta);
-            ev.words = format!(
-                "fast turns are damped {} than the model expects ({} gain {beta:+.4}); explains \
-                 {pct:.0} % of the one-step error energy",
-                if beta < 0.0 { "more" } else { "less" },
-                if cubic { "r³" } else { "r|r|" }
-            );
-        }
-        Effect::Bias { beta } => {
-            ev.parameter = Some(beta);
-            ev.words = format!(
-                "a steady yaw moment worth {beta:+.2}° of rudder/pod angle; explains {pct:.0} % of the \
-                 {SLOW_HORIZON}-step error energy"
-            );
-        }
-        Effect::GyroBias { d_y } => {
-            ev.parameter = Some(d_y);
-            ev.words = format!(
-                "the yaw rate reads {d_y:+.3} °/s off on the {SLOW_HORIZON}-step errors ({pct:.0} % of their energy)"
-            );
-        }
-        Effect::Wind { .. } => {
-            ev.words = format!(
-                "a yaw moment with the heading's 1st and 2nd harmonics takes {pct:.0} % of the \
-                 {SLOW_HORIZON}-step error energy (yaw channel: p {})",
-                fmt_p(p_yaw)
-            );
-        }
-        Effect::Current { .. } => {
-            ev.words = format!(
-                "a yaw moment with the heading's 1st harmonic takes {pct:.0} % of the \
-                 {SLOW_HORIZON}-step error energy (yaw channel: p {})",
-                fmt_p(p_yaw)
-            );
-        }
-    }
+    let (parameter, words) = ev.best.evidence(ts, pct, SLOW_HORIZON, &fmt_p(ev.p_yaw));
+    ev.parameter = parameter;
+    ev.words = words;
 }
 
 /// The effects ranked (module docs): the significant first, among them those their own
@@ -290,7 +217,7 @@ pub(super) fn current_or_wind(ev: &mut Vec<Evidence>, level: f64, alpha: f64, sp
 }
 
 /// Encompassing test between the top two significant effects: both fitted jointly, each
-/// over its whole grid (a dead time and a slew limit that mimic each other alone settle on
+/// over its whole grid (a dead time and a slow gear that mimic each other alone settle on
 /// other values together); what does each add, given the other, beyond the version the
 /// reference shows? `adds_a = N·ln(SSE(a at its reference version, b free)/SSE(both free))`,
 /// judged against a's own bootstrap null. The one that adds nothing significant given the
@@ -641,16 +568,5 @@ fn fmt_p(p: f64) -> String {
 /// assert_eq!(yawcast::diagnose::effect_phrase(EffectKind::DeadBand), "a steering-gear dead band");
 /// ```
 pub fn effect_phrase(kind: EffectKind) -> &'static str {
-    match kind {
-        EffectKind::Bias => "a constant yaw moment",
-        EffectKind::GyroBias => "a rate-gyro offset",
-        EffectKind::DeadTime => "a command dead time",
-        EffectKind::RateLimit => "a rudder/pod slew-rate limit",
-        EffectKind::Saturation => "a rudder/pod angle limit",
-        EffectKind::Asymmetry => "a port/starboard steering asymmetry",
-        EffectKind::NonlinearDamping => "extra nonlinear yaw damping",
-        EffectKind::Wind => "a heading-dependent wind moment",
-        EffectKind::Current => "a current",
-        EffectKind::DeadBand => "a steering-gear dead band",
-    }
+    crate::effects::def(kind).phrase
 }

@@ -7,258 +7,7 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 use yawcast_shared::model::{self as sm, EffectKind, ModelSpec, Units};
 
-/// One library effect with f64 parameters (see `yawcast_shared::model::Effect` for physics).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "effect", rename_all = "kebab-case")]
-pub enum Effect {
-    /// Constant yaw moment: `φ = 1` through B.
-    Bias {
-        /// Gain β (deg of equivalent input).
-        beta: f64,
-    },
-    /// Rate-sensor offset `d_y` (deg/s).
-    GyroBias {
-        /// Output offset.
-        d_y: f64,
-    },
-    /// Command delay of `samples` whole samples.
-    DeadTime {
-        /// Delay (samples).
-        samples: usize,
-    },
-    /// Slew limit ρ (deg/s).
-    RateLimit {
-        /// ρ (deg/s).
-        rate: f64,
-    },
-    /// Angle limit δ_max (deg).
-    Saturation {
-        /// δ_max (deg).
-        limit: f64,
-    },
-    /// Port/starboard gain difference: `φ = max(ũ, 0)` through B.
-    Asymmetry {
-        /// Gain β.
-        beta: f64,
-    },
-    /// Nonlinear hull damping: `φ = y|y|` (or `y³`) through B.
-    NonlinearDamping {
-        /// Gain β.
-        beta: f64,
-        /// Cubic rather than `y|y|`.
-        cubic: bool,
-    },
-    /// Wind: `φ = (sin 2ψ, cos 2ψ, sin ψ, cos ψ)` through B.
-    Wind {
-        /// Gain of sin 2ψ.
-        beta_s2: f64,
-        /// Gain of cos 2ψ.
-        beta_c2: f64,
-        /// Gain of sin ψ.
-        beta_s1: f64,
-        /// Gain of cos ψ.
-        beta_c1: f64,
-    },
-    /// Current: `φ = (sin ψ, cos ψ)` through B.
-    Current {
-        /// Gain of sin ψ.
-        beta_s: f64,
-        /// Gain of cos ψ.
-        beta_c: f64,
-    },
-    /// Steering-gear dead band b (deg): `ũ = clamp(ũ_prev, τ − b, τ + b)`.
-    DeadBand {
-        /// b (deg).
-        width: f64,
-    },
-}
-
-impl Effect {
-    /// The effect's kind.
-    ///
-    /// ```
-    /// use yawcast::identify::model::Effect;
-    /// assert_eq!(Effect::Bias { beta: 1.0 }.kind().name(), "bias");
-    /// ```
-    pub fn kind(&self) -> EffectKind {
-        match self {
-            Effect::Bias { .. } => EffectKind::Bias,
-            Effect::GyroBias { .. } => EffectKind::GyroBias,
-            Effect::DeadTime { .. } => EffectKind::DeadTime,
-            Effect::RateLimit { .. } => EffectKind::RateLimit,
-            Effect::Saturation { .. } => EffectKind::Saturation,
-            Effect::Asymmetry { .. } => EffectKind::Asymmetry,
-            Effect::NonlinearDamping { .. } => EffectKind::NonlinearDamping,
-            Effect::Wind { .. } => EffectKind::Wind,
-            Effect::Current { .. } => EffectKind::Current,
-            Effect::DeadBand { .. } => EffectKind::DeadBand,
-        }
-    }
-
-    /// The effect of `kind` with zero gains (linear parameters to be estimated) and the
-    /// given structural parameter where one is needed (dead time samples, rate, limit).
-    ///
-    /// ```
-    /// use yawcast::identify::model::Effect;
-    /// use yawcast_shared::model::EffectKind;
-    /// assert_eq!(Effect::zero(EffectKind::Current, 0.0), Effect::Current { beta_s: 0.0, beta_c: 0.0 });
-    /// assert_eq!(Effect::zero(EffectKind::DeadTime, 2.0), Effect::DeadTime { samples: 2 });
-    /// ```
-    pub fn zero(kind: EffectKind, structural: f64) -> Effect {
-        match kind {
-            EffectKind::Bias => Effect::Bias { beta: 0.0 },
-            EffectKind::GyroBias => Effect::GyroBias { d_y: 0.0 },
-            EffectKind::DeadTime => Effect::DeadTime {
-                samples: structural.round().max(0.0) as usize,
-            },
-            EffectKind::RateLimit => Effect::RateLimit { rate: structural },
-            EffectKind::Saturation => Effect::Saturation { limit: structural },
-            EffectKind::DeadBand => Effect::DeadBand { width: structural },
-            EffectKind::Asymmetry => Effect::Asymmetry { beta: 0.0 },
-            EffectKind::NonlinearDamping => Effect::NonlinearDamping {
-                beta: 0.0,
-                cubic: false,
-            },
-            EffectKind::Wind => Effect::Wind {
-                beta_s2: 0.0,
-                beta_c2: 0.0,
-                beta_s1: 0.0,
-                beta_c1: 0.0,
-            },
-            EffectKind::Current => Effect::Current {
-                beta_s: 0.0,
-                beta_c: 0.0,
-            },
-        }
-    }
-
-    /// The linear gains this effect adds to the parameter vector (empty for actuator effects).
-    ///
-    /// ```
-    /// use yawcast::identify::model::Effect;
-    /// assert_eq!(Effect::Current { beta_s: 1.0, beta_c: 2.0 }.gains(), vec![1.0, 2.0]);
-    /// ```
-    pub fn gains(&self) -> Vec<f64> {
-        match *self {
-            Effect::Bias { beta } | Effect::Asymmetry { beta } => vec![beta],
-            Effect::NonlinearDamping { beta, .. } => vec![beta],
-            Effect::GyroBias { d_y } => vec![d_y],
-            Effect::Wind {
-                beta_s2,
-                beta_c2,
-                beta_s1,
-                beta_c1,
-            } => vec![beta_s2, beta_c2, beta_s1, beta_c1],
-            Effect::Current { beta_s, beta_c } => vec![beta_s, beta_c],
-            Effect::DeadTime { .. }
-            | Effect::RateLimit { .. }
-            | Effect::Saturation { .. }
-            | Effect::DeadBand { .. } => vec![],
-        }
-    }
-
-    /// Sets the linear gains from `g` (length as returned by [`Effect::gains`]).
-    pub fn set_gains(&mut self, g: &[f64]) {
-        match self {
-            Effect::Bias { beta } | Effect::Asymmetry { beta } => *beta = g[0],
-            Effect::NonlinearDamping { beta, .. } => *beta = g[0],
-            Effect::GyroBias { d_y } => *d_y = g[0],
-            Effect::Wind {
-                beta_s2,
-                beta_c2,
-                beta_s1,
-                beta_c1,
-            } => {
-                *beta_s2 = g[0];
-                *beta_c2 = g[1];
-                *beta_s1 = g[2];
-                *beta_c1 = g[3];
-            }
-            Effect::Current { beta_s, beta_c } => {
-                *beta_s = g[0];
-                *beta_c = g[1];
-            }
-            Effect::DeadTime { .. }
-            | Effect::RateLimit { .. }
-            | Effect::Saturation { .. }
-            | Effect::DeadBand { .. } => {}
-        }
-    }
-
-    fn to_spec(self) -> sm::Effect {
-        match self {
-            Effect::Bias { beta } => sm::Effect::Bias { beta: beta as f32 },
-            Effect::GyroBias { d_y } => sm::Effect::GyroBias { d_y: d_y as f32 },
-            Effect::DeadTime { samples } => sm::Effect::DeadTime {
-                samples: samples.min(255) as u8,
-            },
-            Effect::RateLimit { rate } => sm::Effect::RateLimit { rate: rate as f32 },
-            Effect::DeadBand { width } => sm::Effect::DeadBand {
-                width: width as f32,
-            },
-            Effect::Saturation { limit } => sm::Effect::Saturation {
-                limit: limit as f32,
-            },
-            Effect::Asymmetry { beta } => sm::Effect::Asymmetry { beta: beta as f32 },
-            Effect::NonlinearDamping { beta, cubic } => sm::Effect::NonlinearDamping {
-                beta: beta as f32,
-                cubic,
-            },
-            Effect::Wind {
-                beta_s2,
-                beta_c2,
-                beta_s1,
-                beta_c1,
-            } => sm::Effect::Wind {
-                beta_s2: beta_s2 as f32,
-                beta_c2: beta_c2 as f32,
-                beta_s1: beta_s1 as f32,
-                beta_c1: beta_c1 as f32,
-            },
-            Effect::Current { beta_s, beta_c } => sm::Effect::Current {
-                beta_s: beta_s as f32,
-                beta_c: beta_c as f32,
-            },
-        }
-    }
-
-    fn from_spec(e: &sm::Effect) -> Effect {
-        match *e {
-            sm::Effect::Bias { beta } => Effect::Bias { beta: beta.into() },
-            sm::Effect::GyroBias { d_y } => Effect::GyroBias { d_y: d_y.into() },
-            sm::Effect::DeadTime { samples } => Effect::DeadTime {
-                samples: samples.into(),
-            },
-            sm::Effect::RateLimit { rate } => Effect::RateLimit { rate: rate.into() },
-            sm::Effect::DeadBand { width } => Effect::DeadBand {
-                width: width.into(),
-            },
-            sm::Effect::Saturation { limit } => Effect::Saturation {
-                limit: limit.into(),
-            },
-            sm::Effect::Asymmetry { beta } => Effect::Asymmetry { beta: beta.into() },
-            sm::Effect::NonlinearDamping { beta, cubic } => Effect::NonlinearDamping {
-                beta: beta.into(),
-                cubic,
-            },
-            sm::Effect::Wind {
-                beta_s2,
-                beta_c2,
-                beta_s1,
-                beta_c1,
-            } => Effect::Wind {
-                beta_s2: beta_s2.into(),
-                beta_c2: beta_c2.into(),
-                beta_s1: beta_s1.into(),
-                beta_c1: beta_c1.into(),
-            },
-            sm::Effect::Current { beta_s, beta_c } => Effect::Current {
-                beta_s: beta_s.into(),
-                beta_c: beta_c.into(),
-            },
-        }
-    }
-}
+pub use crate::effects::Effect;
 
 /// Errors building or converting models.
 #[derive(Debug, Error, PartialEq)]
@@ -407,17 +156,7 @@ impl Model {
             }
         }
         for e in &self.effects {
-            let names: &[&str] = match e {
-                Effect::Bias { .. } | Effect::Asymmetry { .. } => &["beta"],
-                Effect::NonlinearDamping { .. } => &["beta"],
-                Effect::GyroBias { .. } => &["d_y"],
-                Effect::Wind { .. } => &["beta_s2", "beta_c2", "beta_s1", "beta_c1"],
-                Effect::Current { .. } => &["beta_s", "beta_c"],
-                Effect::DeadTime { .. }
-                | Effect::RateLimit { .. }
-                | Effect::Saturation { .. }
-                | Effect::DeadBand { .. } => &[],
-            };
+            let names = e.def().gains.iter().map(|(g, _)| g);
             for g in names {
                 v.push(format!("{}.{g}", e.kind().name()));
             }
@@ -715,12 +454,14 @@ mod tests {
 
     #[test]
     fn json_twin_uses_stable_effect_names() {
-        let m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.3, 0.1])
-            .unwrap()
-            .with_effect(Effect::RateLimit { rate: 3.0 });
-        let s = serde_json::to_string(&m).unwrap();
-        assert!(s.contains("\"effect\":\"rate-limit\""), "{s}");
-        let back: Model = serde_json::from_str(&s).unwrap();
-        assert_eq!(back, m);
+        for k in EffectKind::ALL {
+            let m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.3, 0.1])
+                .unwrap()
+                .with_effect(Effect::zero(k, 3.0));
+            let s = serde_json::to_string(&m).unwrap();
+            assert!(s.contains(&format!("\"effect\":\"{}\"", k.name())), "{s}");
+            let back: Model = serde_json::from_str(&s).unwrap();
+            assert_eq!(back, m);
+        }
     }
 }

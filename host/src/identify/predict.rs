@@ -2,13 +2,13 @@
 //!
 //! The step semantics are exactly those of the firmware's `Predictor` (in f64 rather than f32):
 //!
-//! 1. actuator: `delayed = u(t−d)`; `target = clamp(delayed, ±limit)`; with a dead band b,
-//!    `target = clamp(ũ_prev, target − b, target + b)`;
-//!    `ũ = ũ_prev + clamp(target − ũ_prev, ±ρ·Ts)` (or `target` without a rate limit);
+//! 1. actuator: `delayed = u(t−d)`, then `yawcast_shared::kernel::Step::actuator` (limit,
+//!    dead band, largest move per step, each optional);
 //! 2. heading `ψ` = measured ψ when given, else the integrated `ψ̂`;
 //! 3. `y_used` = measured y when finite, else `ŷ = x̂₁ + d_y`;
-//! 4. `v = ũ + Σ β φ` (bias 1, asymmetry max(ũ,0), damping y|y| or y³, wind sin2ψ, cos2ψ,
-//!    sinψ, cosψ, current sinψ, cosψ; ψ in degrees);
+//! 4. `v = ũ + Σ β φ` (`yawcast_shared::kernel::Step::effective_input`: bias 1, asymmetry
+//!    max(ũ,0), damping y|y| or y³, wind sin2ψ, cos2ψ, sinψ, cosψ, current sinψ, cosψ; ψ in
+//!    degrees), accumulated one term at a time;
 //! 5. `e = y − ŷ` (0 when y is missing);
 //! 6. `x̂' = A x̂ + B v + K e`;
 //! 7. `ψ̂' = ψ + Ts·(y_used − d_y)`.
@@ -17,7 +17,9 @@
 //! `x̂(t−k+1|t−k)` and runs k−1 open-loop steps (no measurements, `e = 0`, `y_used = ŷ`).
 //! The first k samples are pure simulation from `x̂(0)`.
 
-use crate::identify::model::{Effect, Model};
+use yawcast_shared::kernel::Step;
+
+use crate::identify::model::Model;
 use crate::io::data::Record;
 
 /// Largest order handled (matches the shared schema).
@@ -105,8 +107,9 @@ impl Clone for State {
     }
 }
 
-/// The model's effects unpacked for fast stepping.
-#[derive(Debug, Clone, Default)]
+/// The model unpacked for fast stepping; its effects are the shared kernel's `f64`
+/// instance (`yawcast_shared::kernel::Step`), the semantics the firmware runs in `f32`.
+#[derive(Debug, Clone)]
 pub struct Stepper {
     n: usize,
     a: [f64; MAX_N],
@@ -114,17 +117,8 @@ pub struct Stepper {
     k: [f64; MAX_N],
     ts: f64,
     d: usize,
-    rate: Option<f64>,
-    limit: Option<f64>,
-    band: Option<f64>,
     d_y: f64,
-    bias: f64,
-    asym: f64,
-    damp: f64,
-    cubic: bool,
-    wind: [f64; 4],
-    current: [f64; 2],
-    heading: bool,
+    fx: Step<f64>,
 }
 
 /// What one filter step returns.
@@ -142,42 +136,21 @@ impl Stepper {
     /// Unpacks `model` (assumed validated).
     pub fn new(model: &Model) -> Stepper {
         let n = model.n.min(MAX_N);
+        let kernel: Vec<_> = model.effects.iter().map(|e| e.to_kernel()).collect();
+        let fx = Step::new(&kernel, model.ts);
         let mut s = Stepper {
             n,
+            a: [0.0; MAX_N],
+            b: [0.0; MAX_N],
+            k: [0.0; MAX_N],
             ts: model.ts,
-            ..Stepper::default()
+            d: usize::from(fx.dead),
+            d_y: fx.dy.unwrap_or(0.0),
+            fx,
         };
         s.a[..n].copy_from_slice(&model.a[..n]);
         s.b[..n].copy_from_slice(&model.b[..n]);
         s.k[..n].copy_from_slice(&model.k[..n]);
-        for e in &model.effects {
-            match *e {
-                Effect::Bias { beta } => s.bias = beta,
-                Effect::GyroBias { d_y } => s.d_y = d_y,
-                Effect::DeadTime { samples } => s.d = samples,
-                Effect::RateLimit { rate } => s.rate = Some(rate),
-                Effect::Saturation { limit } => s.limit = Some(limit),
-                Effect::DeadBand { width } => s.band = Some(width),
-                Effect::Asymmetry { beta } => s.asym = beta,
-                Effect::NonlinearDamping { beta, cubic } => {
-                    s.damp = beta;
-                    s.cubic = cubic;
-                }
-                Effect::Wind {
-                    beta_s2,
-                    beta_c2,
-                    beta_s1,
-                    beta_c1,
-                } => {
-                    s.wind = [beta_s2, beta_c2, beta_s1, beta_c1];
-                    s.heading = true;
-                }
-                Effect::Current { beta_s, beta_c } => {
-                    s.current = [beta_s, beta_c];
-                    s.heading = true;
-                }
-            }
-        }
         s
     }
 
@@ -215,57 +188,15 @@ impl Stepper {
         } else {
             u
         };
-        let target = match self.limit {
-            Some(l) => delayed.clamp(-l, l),
-            None => delayed,
-        };
-        let target = match self.band {
-            // the firmware's comparisons, lower bound first (f64::clamp panics on a NaN bound)
-            Some(b) => {
-                let (lo, hi) = (target - b, target + b);
-                if st.u_prev < lo {
-                    lo
-                } else if st.u_prev > hi {
-                    hi
-                } else {
-                    st.u_prev
-                }
-            }
-            None => target,
-        };
-        let ut = match self.rate {
-            Some(r) => {
-                let step = r * self.ts;
-                st.u_prev + (target - st.u_prev).clamp(-step, step)
-            }
-            None => target,
-        };
+        let ut = self.fx.actuator(delayed, st.u_prev);
         st.u_prev = ut;
         ut
     }
 
-    /// The effect regressor sum Σβφ for actuator output `ut`, output `y_used`, heading `psi` (deg).
-    pub fn effects_sum(&self, ut: f64, y_used: f64, psi: f64) -> f64 {
-        let mut s = self.bias;
-        if self.asym != 0.0 {
-            s += self.asym * ut.max(0.0);
-        }
-        if self.damp != 0.0 {
-            let phi = if self.cubic {
-                y_used * y_used * y_used
-            } else {
-                y_used * y_used.abs()
-            };
-            s += self.damp * phi;
-        }
-        if self.heading {
-            let p = psi.to_radians();
-            let (s1, c1) = p.sin_cos();
-            let (s2, c2) = (2.0 * p).sin_cos();
-            s += self.wind[0] * s2 + self.wind[1] * c2 + self.wind[2] * s1 + self.wind[3] * c1;
-            s += self.current[0] * s1 + self.current[1] * c1;
-        }
-        s
+    /// The effective input `v = ũ + Σβφ` for actuator output `ut`, output `y_used`,
+    /// heading `psi` (deg), accumulated as the firmware does.
+    pub fn effective_input(&self, ut: f64, y_used: f64, psi: f64) -> f64 {
+        self.fx.effective_input(ut, y_used, psi)
     }
 
     /// One filter step with command `u`, measurement `y` (NaN = missing) and optional
@@ -282,7 +213,7 @@ impl Stepper {
         } else {
             (yhat, 0.0)
         };
-        let v = ut + self.effects_sum(ut, y_used, psi);
+        let v = self.effective_input(ut, y_used, psi);
         let n = self.n;
         let x = st.x;
         let mut last = 0.0;
@@ -540,20 +471,13 @@ mod tests {
     }
 
     /// The one-pass multi-horizon predictions equal the definition's bit for bit over the
-    /// whole record, with actuator, damping and heading effects and a missing sample.
+    /// whole record, with every effect of the library and a missing sample.
     #[test]
     fn k_steps_equal_the_definition_bit_for_bit() {
-        let m = m4()
-            .with_effect(Effect::DeadTime { samples: 2 })
-            .with_effect(Effect::RateLimit { rate: 3.0 })
-            .with_effect(Effect::NonlinearDamping {
-                beta: -0.01,
-                cubic: true,
-            })
-            .with_effect(Effect::Current {
-                beta_s: 0.2,
-                beta_c: -0.1,
-            });
+        // the whole library at once
+        let m = yawcast_shared::model::EVERY_EFFECT
+            .iter()
+            .fold(m4(), |m, e| m.with_effect(Effect::from_spec(e)));
         let mut r = rec(150);
         r.psi = Some((0..150).map(|i| i as f64 * 1.7).collect());
         r.y[40] = f64::NAN;
@@ -569,28 +493,18 @@ mod tests {
 
     #[test]
     fn actuator_chain_order() {
+        // dead time 2, then the limit at 5, then a dead band of 1.5
         let m = m4()
             .with_effect(Effect::DeadTime { samples: 2 })
             .with_effect(Effect::Saturation { limit: 5.0 })
-            .with_effect(Effect::RateLimit { rate: 2.0 });
+            .with_effect(Effect::DeadBand { width: 1.5 });
         let s = Stepper::new(&m);
         let mut st = s.initial(&[0.0; 4], 0.0);
-        let outs: Vec<f64> = [10.0, 10.0, 10.0, 10.0, 10.0, -10.0]
+        let outs: Vec<f64> = [1.0, 10.0, 10.0, 1.0, 2.0, 6.0, 6.0]
             .iter()
             .map(|u| s.actuator(&mut st, *u))
             .collect();
-        assert_eq!(outs, vec![0.0, 0.0, 2.0, 4.0, 5.0, 5.0]);
-        // dead band 1.5 before the 2 deg/s slew limit, as in the firmware
-        let m = m4()
-            .with_effect(Effect::DeadBand { width: 1.5 })
-            .with_effect(Effect::RateLimit { rate: 2.0 });
-        let s = Stepper::new(&m);
-        let mut st = s.initial(&[0.0; 4], 0.0);
-        let outs: Vec<f64> = [1.0, 5.0, 5.0, 5.0, 0.0, 1.0]
-            .iter()
-            .map(|u| s.actuator(&mut st, *u))
-            .collect();
-        assert_eq!(outs, vec![0.0, 2.0, 3.5, 3.5, 1.5, 1.5]);
+        assert_eq!(outs, vec![0.0, 0.0, 0.0, 3.5, 3.5, 2.5, 3.5]);
     }
 
     #[test]

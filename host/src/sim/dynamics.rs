@@ -9,6 +9,7 @@
 //! velocity through the air.
 
 use super::{Ship, SimEffect};
+use crate::effects::SimKnobs;
 
 /// Number of states.
 pub(crate) const NX: usize = 6;
@@ -130,37 +131,13 @@ impl Model {
             wind_ne: (0.0, 0.0),
             current_ne: (0.0, 0.0),
         };
-        for e in effects {
-            match *e {
-                SimEffect::Bias { yaw_moment_nm } => model.bias_nm += yaw_moment_nm,
-                SimEffect::Asymmetry { starboard_gain } => model.asym = starboard_gain,
-                SimEffect::NonlinearDamping { n_rr, cubic } => {
-                    model.n_rr = n_rr;
-                    model.cubic = cubic;
-                }
-                SimEffect::Wind {
-                    speed_mps,
-                    from_deg,
-                } => {
-                    let a = from_deg.to_radians();
-                    model.wind_ne = (-speed_mps * a.cos(), -speed_mps * a.sin());
-                }
-                SimEffect::Current {
-                    speed_mps,
-                    towards_deg,
-                } => {
-                    let a = towards_deg.to_radians();
-                    model.current_ne = (speed_mps * a.cos(), speed_mps * a.sin());
-                }
-                // the gyro offset is added to the measurement, the actuator effects act in
-                // [`Actuator`]
-                SimEffect::GyroBias { .. }
-                | SimEffect::DeadTime { .. }
-                | SimEffect::RateLimit { .. }
-                | SimEffect::Saturation { .. }
-                | SimEffect::DeadBand { .. } => {}
-            }
-        }
+        let k = SimKnobs::of(effects);
+        model.bias_nm = k.yaw_moment_nm;
+        model.asym = k.starboard_gain;
+        model.n_rr = k.n_rr;
+        model.cubic = k.cubic;
+        model.wind_ne = k.wind_ne;
+        model.current_ne = k.current_ne;
         model
     }
 
@@ -366,15 +343,16 @@ pub(crate) struct Env {
     pub current: (f64, f64),
 }
 
-/// The pod actuator chain: dead time, angle limit, slew limit and first-order servo lag.
+/// The pod actuator chain: dead time, angle limit, dead band, largest rate and first-order
+/// servo lag.
 #[derive(Debug, Clone)]
 pub(crate) struct Actuator {
     /// Dead time (s).
     pub dead_time: f64,
     /// Angle limit (rad).
     pub limit: f64,
-    /// Slew limit (rad/s).
-    pub slew: f64,
+    /// Largest pod rate (rad/s).
+    pub max_rate: f64,
     /// Servo time constant (s).
     pub tau: f64,
     /// Dead band (backlash) width (rad), 0 without one.
@@ -384,42 +362,42 @@ pub(crate) struct Actuator {
 }
 
 impl Actuator {
+    /// A gear of dead time `dead_time_s`, angle limit `limit_deg`, largest rate
+    /// `max_rate_degps` and servo time constant `tau_s`, with the gear effects of `k` on
+    /// top: their dead time added, the smaller limit and rate, their dead band.
+    pub(crate) fn with_knobs(
+        dead_time_s: f64,
+        limit_deg: f64,
+        max_rate_degps: f64,
+        tau_s: f64,
+        k: &SimKnobs,
+    ) -> Actuator {
+        Actuator {
+            dead_time: dead_time_s + k.dead_time_s,
+            limit: limit_deg.min(k.limit_deg).to_radians(),
+            max_rate: max_rate_degps.min(k.max_rate_degps).to_radians(),
+            tau: tau_s,
+            band: k.band_deg.to_radians(),
+            delta: 0.0,
+        }
+    }
+
     /// The ship's actuator with the actuator effects of `effects` applied.
     pub(crate) fn new(ship: &Ship, effects: &[SimEffect]) -> Actuator {
         let a = &ship.actuator;
-        let mut act = Actuator {
-            dead_time: a.dead_time_s,
-            limit: a.max_angle_deg.to_radians(),
-            slew: a.slew_degps.to_radians(),
-            tau: a.servo_tau_s,
-            band: 0.0,
-            delta: 0.0,
-        };
-        for e in effects {
-            match *e {
-                SimEffect::DeadTime { delay_s } => act.dead_time += delay_s,
-                SimEffect::RateLimit { rate_degps } => {
-                    act.slew = act.slew.min(rate_degps.to_radians());
-                }
-                SimEffect::Saturation { limit_deg } => {
-                    act.limit = act.limit.min(limit_deg.to_radians());
-                }
-                SimEffect::DeadBand { width_deg } => act.band += width_deg.to_radians(),
-                SimEffect::Bias { .. }
-                | SimEffect::GyroBias { .. }
-                | SimEffect::Asymmetry { .. }
-                | SimEffect::NonlinearDamping { .. }
-                | SimEffect::Wind { .. }
-                | SimEffect::Current { .. } => {}
-            }
-        }
-        act
+        Actuator::with_knobs(
+            a.dead_time_s,
+            a.max_angle_deg,
+            a.max_rate_degps,
+            a.servo_tau_s,
+            &SimKnobs::of(effects),
+        )
     }
 
     /// Moves the pod angle over `dt` towards the (delayed) command `cmd` (rad): the limit
     /// clips the target, a dead band leaves the pods where they are while the target is
     /// within the band and otherwise aims them the band's width short of it, the servo lag
-    /// is integrated exactly, the slew limit clips the move.
+    /// is integrated exactly, the largest rate clips the move.
     #[inline]
     pub(crate) fn step(&mut self, cmd: f64, dt: f64) {
         let target = cmd.clamp(-self.limit, self.limit);
@@ -433,7 +411,7 @@ impl Actuator {
         } else {
             1.0
         };
-        let max = self.slew * dt;
+        let max = self.max_rate * dt;
         self.delta += ((target - self.delta) * lag).clamp(-max, max);
     }
 }

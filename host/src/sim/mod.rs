@@ -7,7 +7,7 @@
 //! - **Pods**: thrust `T(J)` vectored at the pod angle δ, plus the lift of the pod housings
 //!   in their local inflow (which gives the hull its course stability); hull–pod interaction
 //!   `a_H` acting at `x_H`.
-//! - **Actuator**: command dead time → angle limit (±35°) → slew limit → first-order servo lag.
+//! - **Actuator**: command dead time → angle limit (±35°) → largest pod rate → first-order servo lag.
 //! - **Environment**: steady wind (`N = ½ρ_a V_r² A_L L_oa C_N(γ_r)`, Isherwood/Blendermann-type
 //!   shapes), steady current (hull and pods see the velocity through the water; inertia terms
 //!   use ground velocities, so a current acting on a turning ship gives a heading-dependent
@@ -44,15 +44,15 @@ use thiserror::Error;
 use crate::io::data::Record;
 
 mod dynamics;
-mod effects;
 mod inputs;
 mod manoeuvres;
 mod ship;
 mod worlds;
 
-pub use effects::{
-    SimEffect, HIDDEN_ASYMMETRY, HIDDEN_BIAS_NM, HIDDEN_CURRENT_MPS, HIDDEN_DEAD_TIME_S,
-    HIDDEN_GYRO_BIAS_DEGPS, HIDDEN_LIMIT_DEG, HIDDEN_N_RR, HIDDEN_RATE_DEGPS, HIDDEN_WIND_MPS,
+pub use crate::effects::{
+    SimEffect, HIDDEN_ASYMMETRY, HIDDEN_BIAS_NM, HIDDEN_CURRENT_MPS, HIDDEN_DEAD_BAND_DEG,
+    HIDDEN_DEAD_TIME_S, HIDDEN_GYRO_BIAS_DEGPS, HIDDEN_LIMIT_DEG, HIDDEN_N_RR, HIDDEN_RATE_DEGPS,
+    HIDDEN_WIND_MPS,
 };
 pub use inputs::InputSpec;
 pub use manoeuvres::{turning_circle, zigzag, TurningResult, ZigzagResult};
@@ -366,13 +366,7 @@ pub fn simulate(ship: &Ship, scenario: &Scenario, seed: u64) -> Result<Record, S
             360.0 * inputs::rng(seed, inputs::STREAM_HEADING).random::<f64>()
         }
     };
-    let gyro_bias: f64 = effects
-        .iter()
-        .filter_map(|e| match e {
-            SimEffect::GyroBias { bias_degps } => Some(*bias_degps),
-            _ => None,
-        })
-        .sum();
+    let gyro_bias = crate::effects::SimKnobs::of(&effects).gyro_bias_degps;
     let open = scenario.input.open_loop(n, ts, seed);
     let mut zz = match scenario.input {
         InputSpec::ZigZag { delta_deg, psi_deg } => {

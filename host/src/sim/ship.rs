@@ -136,8 +136,9 @@ pub struct Actuator {
     pub servo_tau_s: f64,
     /// Angle limit (deg).
     pub max_angle_deg: f64,
-    /// Slew-rate limit (deg/s).
-    pub slew_degps: f64,
+    /// Largest rudder/pod rate (deg/s); the ship file's key is `slew_degps`.
+    #[serde(rename = "slew_degps")]
+    pub max_rate_degps: f64,
     /// Command dead time (s).
     pub dead_time_s: f64,
 }
@@ -334,7 +335,7 @@ impl Ship {
         let a = &self.actuator;
         within("actuator.servo_tau_s", a.servo_tau_s, 0.0, 10.0)?;
         within("actuator.max_angle_deg", a.max_angle_deg, 1e-3, 180.0)?;
-        pos("actuator.slew_degps", a.slew_degps)?;
+        pos("actuator.slew_degps", a.max_rate_degps)?;
         within("actuator.dead_time_s", a.dead_time_s, 0.0, 60.0)?;
         let w = &self.windage;
         non_neg("windage.lateral_area_m2", w.lateral_area_m2)?;

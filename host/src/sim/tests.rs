@@ -117,16 +117,8 @@ fn hidden_effects_cost_a_linear_model_fit_or_show_in_the_channels() {
     let clean = fits(&sc);
     println!("effect-free held-out fit at 10/50 steps {clean:.2?} %");
     assert!(clean[0] > 80.0, "{clean:?}");
-    for k in [
-        EffectKind::Bias,
-        EffectKind::GyroBias,
-        EffectKind::DeadTime,
-        EffectKind::RateLimit,
-        EffectKind::Saturation,
-        EffectKind::Asymmetry,
-        EffectKind::NonlinearDamping,
-        EffectKind::DeadBand,
-    ] {
+    // every effect but the heading ones (their moment depends on the heading history)
+    for k in EffectKind::ALL.into_iter().filter(|k| !k.needs_heading()) {
         let f = fits(&Scenario::with_effect(SimEffect::hidden(k, 1.0)));
         println!("{}: fit at 10/50 steps {f:.2?} %", k.name());
         let cost = (clean[0] - f[0]).max(clean[1] - f[1]);
@@ -149,9 +141,9 @@ fn bad_scenarios_name_the_field() {
     assert!(e.to_string().contains("scenario.ts"), "{e}");
     let e = simulate(
         &ship,
-        &Scenario::with_effect(SimEffect::RateLimit { rate_degps: 0.0 }),
+        &Scenario::with_effect(SimEffect::Saturation { limit_deg: 0.0 }),
         1,
     )
     .unwrap_err();
-    assert!(e.to_string().contains("rate_degps"), "{e}");
+    assert!(e.to_string().contains("limit_deg"), "{e}");
 }

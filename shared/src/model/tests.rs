@@ -135,7 +135,6 @@ fn validate_rejects_each_kind_of_error() {
     for e in [
         Effect::DeadTime { samples: 0 },
         Effect::DeadTime { samples: 33 },
-        Effect::RateLimit { rate: 0.0 },
         Effect::Saturation { limit: -1.0 },
         Effect::Bias { beta: f32::NAN },
         Effect::Wind {

@@ -1,19 +1,17 @@
-//! The actuator-parameter search of step 2: the grid of dead time, slew limit, angle limit
-//! or dead band, each value ranked by frozen-θ cost and by a warm re-identification, the
+//! The actuator-parameter search of step 2: the grid of the effect's structural parameter
+//! (dead time, gear rate, angle limit, dead band), each value ranked by frozen-θ cost and by a warm re-identification, the
 //! golden-section refinement, and the candidate identified from the value chosen.
 
 use yawcast_shared::model::EffectKind;
 
 use super::refit::{reidentify, reidentify_final, reidentify_warm};
 use super::words::describe;
-use super::{AugmentConfig, MAX_DEAD_TIME};
+use super::AugmentConfig;
+use crate::effects::{def, GridSpan};
 use crate::identify::model::{Effect, Model};
 use crate::identify::pem::PemReport;
 use crate::identify::predict;
 use crate::io::data::Record;
-/// Slew-limit grid bounds (deg/s).
-const RATE_GRID: (f64, f64, usize) = (0.5, 20.0, 25);
-
 /// Grid values re-identified fully after each ranking (frozen θ per model, warm re-fit).
 const TOP_FROZEN: usize = 3;
 
@@ -41,63 +39,10 @@ fn frozen_cost(model: &Model, est: &[Record]) -> f64 {
     }
 }
 
-/// The structural-parameter grid of an actuator effect.
+/// The structural-parameter grid of an actuator effect: the effect's own search
+/// ([`crate::effects::Def::search`]) over the estimation records.
 fn actuator_grid(kind: EffectKind, est: &[Record], ts: f64) -> Vec<f64> {
-    match kind {
-        EffectKind::DeadTime => {
-            let shortest = est.iter().map(Record::len).min().unwrap_or(0);
-            let max = MAX_DEAD_TIME.min(shortest / 10).max(1);
-            (1..=max).map(|d| d as f64).collect()
-        }
-        EffectKind::RateLimit => {
-            // ρ·Ts at or above the largest command step is no limit at all
-            let max_step = est
-                .iter()
-                .flat_map(|r| r.u.windows(2).map(|w| (w[1] - w[0]).abs()))
-                .fold(0.0, f64::max);
-            let (lo, hi, k) = RATE_GRID;
-            let hi = hi.min(max_step / ts).max(lo * 1.01);
-            let ratio = (hi / lo).powf(1.0 / (k - 1) as f64);
-            (0..k).map(|i| lo * ratio.powi(i as i32)).collect()
-        }
-        EffectKind::Saturation => {
-            let mut a: Vec<f64> = est
-                .iter()
-                .flat_map(|r| r.u.iter().map(|v| v.abs()))
-                .collect();
-            a.sort_by(f64::total_cmp);
-            if a.is_empty() {
-                return Vec::new();
-            }
-            let q = |p: f64| a[((a.len() - 1) as f64 * p).round() as usize];
-            let top = a[a.len() - 1];
-            let lo = q(0.1).max(1e-3 * top);
-            let mut g: Vec<f64> = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95, 0.99]
-                .iter()
-                .map(|p| q(*p))
-                .chain((0..16).map(|i| lo + (top - lo) * i as f64 / 16.0))
-                .filter(|v| *v > 0.0 && *v < top * (1.0 - 1e-9))
-                .collect();
-            g.sort_by(f64::total_cmp);
-            g.dedup_by(|a, b| (*a - *b).abs() <= 1e-6 * b.abs().max(1e-9));
-            g
-        }
-        // diagnose's widths, over the largest command of the estimation records
-        EffectKind::DeadBand => {
-            let u_max = est
-                .iter()
-                .flat_map(|r| r.u.iter().map(|v| v.abs()))
-                .fold(0.0, f64::max);
-            crate::diagnose::band_widths(u_max)
-        }
-        // not actuator effects: nothing to grid
-        EffectKind::Bias
-        | EffectKind::GyroBias
-        | EffectKind::Asymmetry
-        | EffectKind::NonlinearDamping
-        | EffectKind::Wind
-        | EffectKind::Current => Vec::new(),
-    }
+    (def(kind).search)(&GridSpan::of(ts, est.iter().map(|r| &r.u[..])))
 }
 
 /// The chosen actuator candidate: its re-identification and the grid/refinement trail.
@@ -137,8 +82,8 @@ fn choose_actuator(
         add_best(&score(m), &mut pick);
     }
     // A model identified without the effect has adapted to its absence: with θ frozen, a
-    // slew or angle limit only makes it worse, so the frozen cost can fall monotonically
-    // towards "no limit" and miss a sharp optimum that re-identification finds (a 3 °/s slew
+    // slow gear or an angle limit only makes it worse, so the frozen cost can fall monotonically
+    // towards "no limit" and miss a sharp optimum that re-identification finds (a 3 °/s gear
     // limit on one 1 800 s record: frozen cost best at 20 °/s, re-identified cost 37 % lower
     // at 3 °/s). So every grid value is also re-identified once, warm-started from `base`.
     let warm_cost = |v: &f64| -> f64 {

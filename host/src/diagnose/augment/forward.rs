@@ -100,7 +100,7 @@ fn ser_kinds<S: Serializer>(k: &[EffectKind], s: S) -> Result<S::Ok, S::Error> {
 ///         .map(|(i, v)| v + 0.01 * ((i * 7919 + seed) % 13) as f64).collect();
 ///     r
 /// };
-/// let cands = [EffectKind::DeadTime, EffectKind::RateLimit, EffectKind::Bias];
+/// let cands = [EffectKind::DeadTime, EffectKind::Saturation, EffectKind::Bias];
 /// let rep = forward(&truth, &[rec(1), rec(2)], &[rec(3), rec(4)], &cands,
 ///                   &AugmentConfig::default()).unwrap();
 /// assert_eq!(rep.added[0], EffectKind::DeadTime);

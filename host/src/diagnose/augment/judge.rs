@@ -4,6 +4,7 @@
 
 use std::collections::BTreeMap;
 
+use serde::Serialize;
 use yawcast_shared::model::EffectKind;
 
 use super::refit::reidentify_warm;
@@ -233,6 +234,117 @@ pub(super) fn without_effect(
     (refit, Written::Refit, Some(note))
 }
 
+/// The held-out gains of a candidate over the re-identified baseline (pp) and their
+/// standard errors over the held-out records.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct HeldOutGain {
+    /// Gain at 10 steps.
+    pub g10: f64,
+    /// Its standard error.
+    pub se10: f64,
+    /// Gain in simulation.
+    pub gsim: f64,
+    /// Its standard error.
+    pub sesim: f64,
+}
+
+/// Why a candidate is not kept (step 4); [`Reason::explain`] says it in words.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "reason", rename_all = "kebab-case")]
+pub enum Reason {
+    /// The augmented model could not be identified.
+    NotIdentified,
+    /// Its held-out predictions go non-finite.
+    NonFinite,
+    /// It is unstable.
+    Unstable,
+    /// Rounded to f32 it is no longer a valid stable model.
+    NotExportable {
+        /// Spectral radius of A.
+        radius_a: f64,
+        /// Spectral radius of A − KC.
+        radius_predictor: f64,
+    },
+    /// It fails the f32 export.
+    ExportFails,
+    /// ΔBIC ≥ 0 on the estimation records.
+    BicDoesNotPay {
+        /// ΔBIC.
+        delta_bic: f64,
+    },
+    /// The held-out gain is within the record-to-record spread.
+    WithinSpread(HeldOutGain),
+    /// It predicts significantly worse than the re-identified model.
+    SignificantlyWorse(HeldOutGain),
+    /// It would validate worse than the input model at a horizon.
+    WorseThanInput {
+        /// `"10"` or `"sim"`.
+        horizon: String,
+        /// Its fit (%).
+        after: f64,
+        /// The input model's (%).
+        before: f64,
+    },
+}
+
+impl Reason {
+    /// The reason in words.
+    ///
+    /// ```
+    /// use yawcast::diagnose::augment::Reason;
+    /// let r = Reason::BicDoesNotPay { delta_bic: 3.21 };
+    /// assert_eq!(
+    ///     r.explain(),
+    ///     "ΔBIC = +3.2 ≥ 0 on the estimation records: the extra parameter does not pay for itself"
+    /// );
+    /// ```
+    pub fn explain(&self) -> String {
+        match self {
+            Reason::NotIdentified => {
+                "the augmented model could not be identified (every start failed or went unstable)"
+                    .into()
+            }
+            Reason::NonFinite => "its held-out predictions go non-finite".into(),
+            Reason::Unstable => "it is unstable".into(),
+            Reason::NotExportable {
+                radius_a,
+                radius_predictor,
+            } => format!(
+                "rounded to f32 for the firmware it is no longer a valid stable model (spectral \
+                 radii {radius_a:.7} and {radius_predictor:.7}: a pole on the unit circle, \
+                 typically following an offset the model has no effect for)"
+            ),
+            Reason::ExportFails => "it does not survive the f32 export".into(),
+            Reason::BicDoesNotPay { delta_bic } => format!(
+                "ΔBIC = {delta_bic:+.1} ≥ 0 on the estimation records: the extra parameter does \
+                 not pay for itself"
+            ),
+            Reason::WithinSpread(g) => format!(
+                "the held-out gain over the re-identified model ({:+.2} ± {:.2} pp at 10 steps, \
+                 {:+.2} ± {:.2} pp in simulation) is within the record-to-record spread",
+                g.g10, g.se10, g.gsim, g.sesim
+            ),
+            Reason::SignificantlyWorse(g) => format!(
+                "it predicts significantly worse than the re-identified model ({:+.2} ± {:.2} pp \
+                 at 10 steps, {:+.2} ± {:.2} pp in simulation)",
+                g.g10, g.se10, g.gsim, g.sesim
+            ),
+            Reason::WorseThanInput {
+                horizon,
+                after,
+                before,
+            } => format!(
+                "it would validate worse than the input model at {} ({after:.1} < {before:.1} %)",
+                if horizon == "sim" {
+                    "simulation".to_string()
+                } else {
+                    format!("{horizon} steps")
+                }
+            ),
+        }
+    }
+}
+
 /// What step 4 weighs for one candidate against the baseline.
 pub(super) struct Judgement {
     pub(super) delta_aic: f64,
@@ -245,7 +357,7 @@ pub(super) struct Judgement {
     pub(super) sig: bool,
     pub(super) stable: bool,
     /// Why the candidate is not kept; empty when it is.
-    pub(super) reasons: Vec<String>,
+    pub(super) reasons: Vec<Reason>,
     /// Whether it is kept (no reason against it).
     pub(super) kept: bool,
 }
@@ -272,25 +384,22 @@ pub(super) fn judge(
     let get = |e: &Eval, k: &str| e.mean.get(k).copied().unwrap_or(f64::NAN);
     let stable = cand.model.is_stable();
     let exports = round_trips(&cand.model);
-    let mut reasons: Vec<String> = Vec::new();
+    let mut reasons: Vec<Reason> = Vec::new();
     if !after.finite {
-        reasons.push("its held-out predictions go non-finite".into());
+        reasons.push(Reason::NonFinite);
     }
     if !stable {
-        reasons.push("it is unstable".into());
+        reasons.push(Reason::Unstable);
     }
     if stable && !exports {
-        let (ra, rp) = cand.model.spectral_radii();
-        reasons.push(format!(
-            "rounded to f32 for the firmware it is no longer a valid stable model (spectral \
-             radii {ra:.7} and {rp:.7}: a pole on the unit circle, typically following an \
-             offset the model has no effect for)"
-        ));
+        let (radius_a, radius_predictor) = cand.model.spectral_radii();
+        reasons.push(Reason::NotExportable {
+            radius_a,
+            radius_predictor,
+        });
     }
     if delta_bic.is_nan() || delta_bic >= 0.0 {
-        reasons.push(format!(
-            "ΔBIC = {delta_bic:+.1} ≥ 0 on the estimation records: the extra parameter does not pay for itself"
-        ));
+        reasons.push(Reason::BicDoesNotPay { delta_bic });
     }
     let sig = t10 > tc || tsim > tc;
     // decisive estimation evidence (ΔBIC ≤ −10, "very strong" on Kass and Raftery's scale)
@@ -299,30 +408,25 @@ pub(super) fn judge(
     // physical model is kept — it predicts as well and can go into the simulator
     let decisive = delta_bic <= DECISIVE_BIC && t10 >= -tc && tsim >= -tc;
     let worse = t10 < -tc || tsim < -tc;
+    let gains = HeldOutGain {
+        g10,
+        se10,
+        gsim,
+        sesim,
+    };
     if !sig && !decisive && !worse {
-        reasons.push(format!(
-            "the held-out gain over the re-identified model ({g10:+.2} ± {se10:.2} pp at 10 steps, \
-             {gsim:+.2} ± {sesim:.2} pp in simulation) is within the record-to-record spread"
-        ));
+        reasons.push(Reason::WithinSpread(gains));
     }
     if worse {
-        reasons.push(format!(
-            "it predicts significantly worse than the re-identified model ({g10:+.2} ± \
-             {se10:.2} pp at 10 steps, {gsim:+.2} ± {sesim:.2} pp in simulation)"
-        ));
+        reasons.push(Reason::SignificantlyWorse(gains));
     }
     for k in ["10", "sim"] {
         if get(after, k) < get(before, k) {
-            reasons.push(format!(
-                "it would validate worse than the input model at {} ({:.1} < {:.1} %)",
-                if k == "sim" {
-                    "simulation".to_string()
-                } else {
-                    format!("{k} steps")
-                },
-                get(after, k),
-                get(before, k)
-            ));
+            reasons.push(Reason::WorseThanInput {
+                horizon: k.to_string(),
+                after: get(after, k),
+                before: get(before, k),
+            });
         }
     }
     let kept = reasons.is_empty();

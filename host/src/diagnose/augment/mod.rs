@@ -13,10 +13,11 @@
 //!    - *Linear-gain effects* (bias, gyro bias, asymmetry, nonlinear damping, wind, current):
 //!      PEM from the ARX, ARMAX and subspace starts, from the input model with the new gain
 //!      at zero and from the baseline with the new gain at zero.
-//!    - *Actuator effects* (dead time d, slew limit ρ, angle limit δ_max): a grid of the
-//!      structural parameter (d = 1..=[`MAX_DEAD_TIME`] samples; ρ on a log grid over
-//!      0.5–20 °/s, which covers real steering gears' 2.3–9 °/s; δ_max over the quantiles
-//!      of the recorded |δ|). Every grid value is scored cheaply with θ frozen (one-step cost
+//!    - *Actuator effects* (dead time d, gear rate ρ, angle limit δ_max, dead band b): a
+//!      grid of the structural parameter, the effect's own search
+//!      ([`crate::effects::Def::search`]: d = 1..=[`MAX_DEAD_TIME`] samples; ρ on a log grid
+//!      over 0.5–20 °/s, which covers real steering gears' 2.3–9 °/s; δ_max over the
+//!      quantiles of the recorded |δ|; b over 0.2–6°). Every grid value is scored cheaply with θ frozen (one-step cost
 //!      of the input and of the baseline model with the effect added) and once more after a
 //!      warm-started re-identification (θ frozen without the effect can miss a sharp optimum);
 //!      the best few of each ranking are re-identified fully, and a continuous parameter is
@@ -66,15 +67,18 @@ use crate::identify::predict::Horizon;
 use crate::io::data::Record;
 
 mod actuator;
+mod auto;
 mod forward;
 mod judge;
 mod refit;
 mod simulator;
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
 mod words;
 
+pub use auto::{gear_base, GearBase};
 pub use forward::{forward, ForwardReport, Round, Tried};
+pub use judge::{HeldOutGain, Reason};
 pub use simulator::to_sim_effect;
 pub use words::describe;
 
@@ -134,7 +138,7 @@ fn ser_kind<S: Serializer>(k: &EffectKind, s: S) -> Result<S::Ok, S::Error> {
 /// What [`augment`] found.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct AugmentReport {
-    /// The effect tried (serialised as its name, e.g. `"rate-limit"`).
+    /// The effect tried (serialised as its name, e.g. `"dead-time"`).
     #[serde(serialize_with = "ser_kind")]
     pub effect: EffectKind,
     /// The model with the effect added and re-identified.
@@ -166,6 +170,9 @@ pub struct AugmentReport {
     pub ljung_box_p_after: f64,
     /// STD% of the candidate's estimated parameters (θ then effect gains).
     pub std_pct: Vec<f64>,
+    /// Why the effect is not kept (empty when it is): the typed reasons the explanation
+    /// words.
+    pub reasons: Vec<Reason>,
     /// Physical words with numbers: the effect's size, the fits, the decision and why.
     pub explanation: String,
 }
@@ -336,7 +343,7 @@ fn try_effect(
             baseline,
             horizons,
             held_note,
-            "the augmented model could not be identified (every start failed or went unstable)",
+            Reason::NotIdentified,
         );
     };
     let after = evaluate(&cand.model, val_part, horizons, cfg.parallel);
@@ -357,7 +364,7 @@ fn try_effect(
     }
     if j.kept && !round_trips(&cand_model) {
         j.kept = false;
-        j.reasons.push("it does not survive the f32 export".into());
+        j.reasons.push(Reason::ExportFails);
     }
     let text = explanation(
         kind,
@@ -398,6 +405,7 @@ fn try_effect(
         ljung_box_p_before: ljung_box_p(&before.resid),
         ljung_box_p_after: ljung_box_p(&after.resid),
         std_pct,
+        reasons: j.reasons,
         explanation: text,
     }
 }
@@ -411,12 +419,13 @@ fn failed_report(
     baseline: &Eval,
     horizons: &[Horizon],
     held_note: Option<String>,
-    why: &str,
+    why: Reason,
 ) -> AugmentReport {
     let nan: BTreeMap<String, f64> = horizons.iter().map(|h| (h.key(), f64::NAN)).collect();
     let mut text = format!(
-        "{}: not kept: {why}; the model is kept without it",
-        describe(&Effect::zero(kind, 0.0), model.ts)
+        "{}: not kept: {}; the model is kept without it",
+        describe(&Effect::zero(kind, 0.0), model.ts),
+        why.explain()
     );
     if let Some(n) = held_note {
         text.push_str(&format!(". Note: {n}"));
@@ -436,6 +445,7 @@ fn failed_report(
         ljung_box_p_before: ljung_box_p(&before.resid),
         ljung_box_p_after: f64::NAN,
         std_pct: Vec::new(),
+        reasons: vec![why],
         explanation: text,
     }
 }

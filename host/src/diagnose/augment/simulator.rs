@@ -3,6 +3,7 @@
 
 use rayon::prelude::*;
 
+use crate::effects::SimCounterpart;
 use crate::identify::model::{Effect, Model};
 use crate::identify::predict;
 use crate::io::data::Record;
@@ -13,7 +14,7 @@ use crate::sim::{self, Scenario, Ship, SimEffect};
 ///
 /// Conversions and their approximations:
 /// - dead time: `samples·Ts` (the simulator's delay acts before its own servo lag);
-/// - slew limit, angle limit, gyro offset: carried over unchanged (the model's ũ is the pod
+/// - the gear's rate, angle limit, dead band, gyro offset: carried over unchanged (the model's ũ is the pod
 ///   angle before the simulator's servo lag);
 /// - asymmetry β: starboard gain β (the model scales the effective input by `1 + β` for
 ///   δ > 0, the simulator the steering part of the pods' side force);
@@ -36,20 +37,11 @@ use crate::sim::{self, Scenario, Ship, SimEffect};
 /// assert_eq!(e, Some(SimEffect::DeadTime { delay_s: 2.0 }));
 /// ```
 pub fn to_sim_effect(effect: &Effect, model: &Model, ship: &Ship) -> Option<SimEffect> {
-    let e = match *effect {
-        Effect::DeadTime { samples } => SimEffect::DeadTime {
-            delay_s: samples as f64 * model.ts,
-        },
-        Effect::RateLimit { rate } => SimEffect::RateLimit { rate_degps: rate },
-        Effect::Saturation { limit } => SimEffect::Saturation { limit_deg: limit },
-        Effect::DeadBand { width } => SimEffect::DeadBand { width_deg: width },
-        Effect::GyroBias { d_y } => SimEffect::GyroBias { bias_degps: d_y },
-        Effect::Asymmetry { beta } => SimEffect::Asymmetry {
-            starboard_gain: beta.max(-0.95),
-        },
-        Effect::Bias { beta } => bias_to_moment(beta, ship)?,
-        Effect::NonlinearDamping { beta, cubic } => damping_to_nrr(beta, cubic, model, ship)?,
-        Effect::Wind { .. } | Effect::Current { .. } => heading_effect(effect, model, ship)?,
+    let e = match effect.sim_counterpart(model.ts) {
+        SimCounterpart::Direct(e) => e,
+        SimCounterpart::Moment { beta } => bias_to_moment(beta, ship)?,
+        SimCounterpart::Damping { beta, cubic } => damping_to_nrr(beta, cubic, model, ship)?,
+        SimCounterpart::Heading => heading_effect(effect, model, ship)?,
     };
     e.validate("effect").ok()?;
     Some(e)
@@ -238,23 +230,7 @@ pub(super) fn reference_harmonics(
 
 /// (β_s2, β_c2, β_s1, β_c1) of a wind or current effect.
 fn harmonics(e: &Effect) -> Option<[f64; 4]> {
-    match *e {
-        Effect::Wind {
-            beta_s2,
-            beta_c2,
-            beta_s1,
-            beta_c1,
-        } => Some([beta_s2, beta_c2, beta_s1, beta_c1]),
-        Effect::Current { beta_s, beta_c } => Some([0.0, 0.0, beta_s, beta_c]),
-        Effect::Bias { .. }
-        | Effect::GyroBias { .. }
-        | Effect::DeadTime { .. }
-        | Effect::RateLimit { .. }
-        | Effect::Saturation { .. }
-        | Effect::DeadBand { .. }
-        | Effect::Asymmetry { .. }
-        | Effect::NonlinearDamping { .. } => None,
-    }
+    e.harmonics()
 }
 
 /// The harmonics of `h(ψ − Δ)` given those of `h(ψ)` (Δ in degrees): a moment that depends

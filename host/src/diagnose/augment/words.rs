@@ -6,69 +6,21 @@ use std::collections::BTreeMap;
 use yawcast_shared::model::EffectKind;
 
 use super::forward::Round;
-use super::judge::{Eval, Judgement, DECISIVE_BIC};
+use super::judge::{Eval, Judgement, Reason, DECISIVE_BIC};
 use crate::identify::model::{Effect, Model};
-/// The effect in physical words (`ts`: the model's sample time, s).
+/// The effect in physical words (`ts`: the model's sample time, s): the effect's own
+/// ([`Effect::describe`]).
 ///
 /// ```
 /// use yawcast::{diagnose::augment::describe, identify::model::Effect};
-/// assert_eq!(describe(&Effect::RateLimit { rate: 3.14 }, 1.0), "a slew limit of 3.1 °/s");
+/// assert_eq!(describe(&Effect::Saturation { limit: 8.04 }, 1.0), "a pod angle limit of ±8.0°");
 /// assert_eq!(
 ///     describe(&Effect::DeadTime { samples: 4 }, 0.5),
 ///     "a command dead time of 4 samples (2.0 s)"
 /// );
 /// ```
 pub fn describe(effect: &Effect, ts: f64) -> String {
-    match *effect {
-        Effect::Bias { beta } => format!(
-            "a constant yaw moment equal to {beta:+.2}° of pod angle ({})",
-            if beta >= 0.0 {
-                "to starboard"
-            } else {
-                "to port"
-            }
-        ),
-        Effect::GyroBias { d_y } => format!("a rate-gyro offset of {d_y:+.3} °/s"),
-        Effect::DeadTime { samples } => format!(
-            "a command dead time of {samples} sample{} ({:.1} s)",
-            if samples == 1 { "" } else { "s" },
-            samples as f64 * ts
-        ),
-        Effect::RateLimit { rate } => format!("a slew limit of {rate:.1} °/s"),
-        Effect::Saturation { limit } => format!("a pod angle limit of ±{limit:.1}°"),
-        Effect::DeadBand { width } => format!("a steering-gear dead band of {width:.2}°"),
-        Effect::Asymmetry { beta } => format!(
-            "starboard pod deflections {:.0} % {} effective than port ones",
-            100.0 * beta.abs(),
-            if beta >= 0.0 { "more" } else { "less" }
-        ),
-        Effect::NonlinearDamping { beta, cubic } => format!(
-            "{} yaw damping beyond linear: {beta:+.4}° of pod angle per {}",
-            if beta <= 0.0 { "extra" } else { "less" },
-            if cubic {
-                "(°/s)³"
-            } else {
-                "(°/s)² of r·|r|"
-            }
-        ),
-        Effect::Wind {
-            beta_s2,
-            beta_c2,
-            beta_s1,
-            beta_c1,
-        } => format!(
-            "a heading-dependent yaw moment (wind): {:.2}° of pod angle at twice the heading \
-             frequency and {:.2}° at once",
-            beta_s2.hypot(beta_c2),
-            beta_s1.hypot(beta_c1)
-        ),
-        Effect::Current { beta_s, beta_c } => format!(
-            "a heading-dependent yaw moment (current) of {:.2}° of pod angle, largest to \
-             starboard on heading {:.0}°",
-            beta_s.hypot(beta_c),
-            beta_s.atan2(beta_c).to_degrees().rem_euclid(360.0)
-        ),
-    }
+    effect.describe(ts)
 }
 
 /// The explanation of one candidate: the effect in words, the fits, the decision and why
@@ -127,7 +79,8 @@ pub(super) fn explanation(
              physical model is preferred"
         ));
     } else {
-        text.push_str(&format!(". Not kept: {}", reasons.join("; ")));
+        let why: Vec<String> = reasons.iter().map(Reason::explain).collect();
+        text.push_str(&format!(". Not kept: {}", why.join("; ")));
         if !sig && after.finite && stable {
             text.push_str(
                 " — the Kalman gain already re-anchors the prediction on the measured yaw rate, \

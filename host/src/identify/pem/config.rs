@@ -311,3 +311,32 @@ pub enum IdentError {
     #[error("cannot refine: {0}")]
     Refine(String),
 }
+
+impl IdentError {
+    /// Whether the records or settings are at fault (bad input) rather than the search: a
+    /// search that found no stable model (every start failed, an unstable optimum or start)
+    /// is not the input's fault.
+    ///
+    /// ```
+    /// use yawcast::identify::pem::IdentError;
+    /// assert!(IdentError::NoRecords.is_bad_input());
+    /// assert!(!IdentError::Unstable.is_bad_input());
+    /// ```
+    pub fn is_bad_input(&self) -> bool {
+        match self {
+            IdentError::NoRecords
+            | IdentError::Order(_)
+            | IdentError::TooFewSamples { .. }
+            | IdentError::RecordTooShort { .. }
+            | IdentError::ConstantInput { .. }
+            | IdentError::NonFinite { .. }
+            | IdentError::Ragged { .. }
+            | IdentError::SampleTime { .. }
+            | IdentError::Config(_)
+            | IdentError::Refine(_) => true,
+            IdentError::StartUnstable | IdentError::AllStartsFailed(_) | IdentError::Unstable => {
+                false
+            }
+        }
+    }
+}

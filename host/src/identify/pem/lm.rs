@@ -150,7 +150,13 @@ impl Problem<'_> {
                 }
             }
             accs = self.jac(&params, &x0);
-            if !self.lay.heading && self.lay.gains.iter().all(|g| *g != sens::Gain::Damp) {
+            if !self.lay.heading
+                && self
+                    .lay
+                    .gains
+                    .iter()
+                    .all(|g| *g != crate::effects::Regressor::Damping)
+            {
                 break;
             }
         }

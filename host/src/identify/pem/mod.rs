@@ -4,8 +4,8 @@
 //! Cost: `V(θ) = (1/N) Σ ε(t,θ)² + (1/N) λ (θ−θ*)ᵀ R (θ−θ*)` over all samples of all records
 //! (θ* = 0 unless a nominal vector is given), minimised by Levenberg–Marquardt with the exact
 //! sensitivities of the one-step predictor ([`crate::identify::predict::Stepper`]). θ holds (a, b, k)
-//! and the linear gains of the template's effects; actuator effects (dead time, rate limit,
-//! saturation) stay as given. Each record has its own x̂(0), estimated jointly with θ (the
+//! and the linear gains of the template's effects; actuator effects (dead time, gear rate, angle
+//! limit, dead band) stay as given. Each record has its own x̂(0), estimated jointly with θ (the
 //! initial states are eliminated from the normal equations, so they cost nothing extra).
 //!
 //! Starts: ARX least squares, an ARMAX fit by extended least squares and a subspace (N4SID)

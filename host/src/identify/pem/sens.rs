@@ -6,34 +6,10 @@
 //! computes — including missing measurements (`y_used = ŷ`), effects that use `y` and an
 //! integrated heading.
 
-use crate::identify::model::{Effect, Model};
+use crate::effects::Regressor;
+use crate::identify::model::Model;
 use crate::identify::predict::{Stepper, MAX_N};
 use crate::io::data::Record;
-
-/// What one effect-gain column multiplies.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Gain {
-    /// φ = 1 (bias).
-    Bias,
-    /// Output offset d_y (gyro bias).
-    GyroBias,
-    /// φ = max(ũ, 0).
-    Asym,
-    /// φ = y|y| or y³.
-    Damp,
-    /// φ = sin 2ψ.
-    WindS2,
-    /// φ = cos 2ψ.
-    WindC2,
-    /// φ = sin ψ (wind).
-    WindS1,
-    /// φ = cos ψ (wind).
-    WindC1,
-    /// φ = sin ψ (current).
-    CurS,
-    /// φ = cos ψ (current).
-    CurC,
-}
 
 /// Layout of the estimated vector: θ = (a, b, k) then the effect gains in
 /// [`Model::effect_gains`] order; the x̂(0) columns follow in the Jacobian.
@@ -44,7 +20,7 @@ pub(crate) struct Layout {
     /// Number of estimated parameters (3n + gains).
     pub p: usize,
     /// Kind of each gain column (index 3n + j).
-    pub gains: Vec<Gain>,
+    pub gains: Vec<Regressor>,
     /// Column of d_y, if estimated.
     pub dy: Option<usize>,
     /// Heading effects present (ψ̂ integrated when not measured).
@@ -61,31 +37,13 @@ impl Layout {
         let mut cubic = false;
         let mut heading = false;
         for e in &model.effects {
-            match *e {
-                Effect::Bias { .. } => gains.push(Gain::Bias),
-                Effect::GyroBias { .. } => gains.push(Gain::GyroBias),
-                Effect::Asymmetry { .. } => gains.push(Gain::Asym),
-                Effect::NonlinearDamping { cubic: c, .. } => {
-                    cubic = c;
-                    gains.push(Gain::Damp);
-                }
-                Effect::Wind { .. } => {
-                    heading = true;
-                    gains.extend([Gain::WindS2, Gain::WindC2, Gain::WindS1, Gain::WindC1]);
-                }
-                Effect::Current { .. } => {
-                    heading = true;
-                    gains.extend([Gain::CurS, Gain::CurC]);
-                }
-                Effect::DeadTime { .. }
-                | Effect::RateLimit { .. }
-                | Effect::Saturation { .. }
-                | Effect::DeadBand { .. } => {}
-            }
+            gains.extend(e.def().gains.iter().map(|(_, r)| *r));
+            cubic |= e.cubic();
+            heading |= e.kind().needs_heading();
         }
         let dy = gains
             .iter()
-            .position(|g| *g == Gain::GyroBias)
+            .position(|g| *g == Regressor::Offset)
             .map(|j| 3 * n + j);
         Layout {
             n,
@@ -258,17 +216,15 @@ fn pass_n<const N: usize, S: Sink>(
     let gains = model.effect_gains();
     // β of damping and of the heading regressors, for the y and ψ partials of v.
     let mut damp = 0.0;
-    let mut hb = [0.0f64; 6]; // wind s2 c2 s1 c1, current s c
+    let mut hb = [0.0f64; 4]; // of sin 2ψ, cos 2ψ, sin ψ, cos ψ (wind and current summed)
     for (j, g) in lay.gains.iter().enumerate() {
         match g {
-            Gain::Damp => damp = gains[j],
-            Gain::WindS2 => hb[0] = gains[j],
-            Gain::WindC2 => hb[1] = gains[j],
-            Gain::WindS1 => hb[2] = gains[j],
-            Gain::WindC1 => hb[3] = gains[j],
-            Gain::CurS => hb[4] = gains[j],
-            Gain::CurC => hb[5] = gains[j],
-            _ => {}
+            Regressor::Damping => damp = gains[j],
+            Regressor::Sin2 => hb[0] += gains[j],
+            Regressor::Cos2 => hb[1] += gains[j],
+            Regressor::Sin1 => hb[2] += gains[j],
+            Regressor::Cos1 => hb[3] += gains[j],
+            Regressor::One | Regressor::Offset | Regressor::Starboard => {}
         }
     }
     let dy_col = lay.dy.unwrap_or(usize::MAX);
@@ -303,20 +259,20 @@ fn pass_n<const N: usize, S: Sink>(
         }
         for (j, g) in lay.gains.iter().enumerate() {
             phi[j] = match g {
-                Gain::Bias => 1.0,
-                Gain::GyroBias => 0.0,
-                Gain::Asym => o.u_eff.max(0.0),
-                Gain::Damp => {
+                Regressor::One => 1.0,
+                Regressor::Offset => 0.0,
+                Regressor::Starboard => o.u_eff.max(0.0),
+                Regressor::Damping => {
                     if lay.cubic {
                         y_used * y_used * y_used
                     } else {
                         y_used * y_used.abs()
                     }
                 }
-                Gain::WindS2 => s2,
-                Gain::WindC2 => c2,
-                Gain::WindS1 | Gain::CurS => s1,
-                Gain::WindC1 | Gain::CurC => c1,
+                Regressor::Sin2 => s2,
+                Regressor::Cos2 => c2,
+                Regressor::Sin1 => s1,
+                Regressor::Cos1 => c1,
             };
         }
         let dv_dy = if yfin || damp == 0.0 {
@@ -328,7 +284,7 @@ fn pass_n<const N: usize, S: Sink>(
         };
         let dv_dpsi = if lay.heading && !psi_meas {
             let d = std::f64::consts::PI / 180.0;
-            d * (2.0 * hb[0] * c2 - 2.0 * hb[1] * s2 + (hb[2] + hb[4]) * c1 - (hb[3] + hb[5]) * s1)
+            d * (2.0 * hb[0] * c2 - 2.0 * hb[1] * s2 + hb[2] * c1 - hb[3] * s1)
         } else {
             0.0
         };
@@ -388,6 +344,7 @@ fn pass_n<const N: usize, S: Sink>(
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::identify::model::Effect;
     use crate::identify::predict;
 
     /// Collects rows for Jacobian checks.

@@ -26,11 +26,11 @@
 //!   fibre-optic gyro's bias instability (0.002 °/s, 10 min) and resolution (0.001 °/s); the
 //!   compass's white noise on top of a gyrocompass's slow error (0.1°, 2 min) and its 0.1°
 //!   resolution.
-//! - **Steering gear**: dead time → angle limit → rate limit → first-order servo lag, as on
+//! - **Steering gear**: dead time → angle limit → largest rudder rate → first-order servo lag, as on
 //!   the built-in ship, with each hull's own limits.
 //! - **Effects** ([`SimEffect`]) act as on the built-in ship, in the world's own units:
 //!   `bias` a steady yaw moment (N·m), `gyro-bias` an offset of the measured rate,
-//!   `dead-time`, `rate-limit` and `saturation` the gear, `asymmetry` the rudder's
+//!   the actuator effects the gear, `asymmetry` the rudder's
 //!   starboard effectiveness, `nonlinear-damping` a Norrbin term `−n_rr ½ρL⁴d r|r|`, `wind`
 //!   and `current` the environment. [`World::hidden`] gives the canonical strengths of the
 //!   built-in ship carried over to the hull (below).
@@ -55,6 +55,7 @@ use super::dynamics::{self, Model};
 use super::inputs::{self, InputSpec, ZigZagLogic};
 use super::manoeuvres::{TurningTracker, ZigzagTracker};
 use super::{NoiseSpec, Scenario, Ship, SimEffect, SimError, TurningResult, ZigzagResult};
+use crate::effects::{HullScale, SimKnobs};
 use crate::io::data::Record;
 
 pub(crate) mod env;
@@ -122,7 +123,7 @@ pub(crate) struct Gear {
     pub tau_s: f64,
     /// Angle limit (deg).
     pub limit_deg: f64,
-    /// Rate limit (deg/s).
+    /// Largest rudder rate (deg/s).
     pub rate_degps: f64,
 }
 
@@ -264,7 +265,7 @@ impl World {
     /// The canonical hidden effect of `kind` at `strength` on this world: the built-in
     /// ship's ([`SimEffect::hidden`]) carried over to the hull. Angles, gains and `n_rr`
     /// stay; times (dead time) scale with the hull's time `L_pp/U` over the built-in ship's
-    /// and rates (gyro bias, rate limit) with its inverse; the yaw moment keeps its
+    /// and rates (gyro bias, the gear's largest rate) with its inverse; the yaw moment keeps its
     /// non-dimensional value `N/(½ρL²dU²)`; wind and current keep their full-scale speeds
     /// (the built-in ship's × √24: 14.7 m/s and 1.47 m/s at full strength), Froude-scaled
     /// to the hull.
@@ -282,45 +283,14 @@ impl World {
             return base;
         };
         let t = self.time_ratio();
-        let v = LNG_SCALE.sqrt() * h.froude_time();
-        match base {
-            SimEffect::Bias { yaw_moment_nm } => {
-                let (l, d, rho, u) = lng_reference();
-                let nd = yaw_moment_nm / (0.5 * rho * l * l * d * u * u);
-                let u0 = h.u0();
-                SimEffect::Bias {
-                    yaw_moment_nm: nd * 0.5 * h.rho() * h.lpp().powi(2) * h.draft() * u0 * u0,
-                }
-            }
-            SimEffect::GyroBias { bias_degps } => SimEffect::GyroBias {
-                bias_degps: bias_degps / t,
-            },
-            SimEffect::DeadTime { delay_s } => SimEffect::DeadTime {
-                delay_s: delay_s * t,
-            },
-            SimEffect::RateLimit { rate_degps } => SimEffect::RateLimit {
-                rate_degps: rate_degps / t,
-            },
-            SimEffect::Wind {
-                speed_mps,
-                from_deg,
-            } => SimEffect::Wind {
-                speed_mps: speed_mps * v,
-                from_deg,
-            },
-            SimEffect::Current {
-                speed_mps,
-                towards_deg,
-            } => SimEffect::Current {
-                speed_mps: speed_mps * v,
-                towards_deg,
-            },
-            // angles and non-dimensional gains carry over unchanged
-            SimEffect::Saturation { .. }
-            | SimEffect::DeadBand { .. }
-            | SimEffect::Asymmetry { .. }
-            | SimEffect::NonlinearDamping { .. } => base,
-        }
+        let (l, d, rho, u) = lng_reference();
+        let u0 = h.u0();
+        base.on_hull(&HullScale {
+            time: t,
+            speed: LNG_SCALE.sqrt() * h.froude_time(),
+            moment: (0.5 * h.rho() * h.lpp().powi(2) * h.draft() * u0 * u0)
+                / (0.5 * rho * l * l * d * u * u),
+        })
     }
 
     /// Simulates one trial under `scenario` with `seed`, as [`simulate`](super::simulate)
@@ -421,14 +391,9 @@ impl Physics {
     /// `asymmetry` effect's gain (for [`Hull::set_asymmetry`]).
     fn new(hull: &dyn Hull, effects: &[SimEffect]) -> (Physics, dynamics::Actuator, f64) {
         let gear = hull.gear();
-        let mut act = dynamics::Actuator {
-            dead_time: 0.0,
-            limit: gear.limit_deg.to_radians(),
-            slew: gear.rate_degps.to_radians(),
-            tau: gear.tau_s,
-            band: 0.0,
-            delta: 0.0,
-        };
+        let k = SimKnobs::of(&merged(effects));
+        let act =
+            dynamics::Actuator::with_knobs(0.0, gear.limit_deg, gear.rate_degps, gear.tau_s, &k);
         let (l, d, rho) = (hull.lpp(), hull.draft(), hull.rho());
         let mut p = Physics {
             windage: hull.windage(),
@@ -442,41 +407,13 @@ impl Physics {
             half_rho_l4d: 0.5 * rho * l.powi(4) * d,
             lpp: l,
         };
-        let mut asym = 0.0;
-        for e in merged(effects) {
-            match e {
-                SimEffect::Bias { yaw_moment_nm } => p.bias_nm = yaw_moment_nm,
-                SimEffect::GyroBias { bias_degps } => p.gyro_bias = bias_degps,
-                SimEffect::DeadTime { delay_s } => act.dead_time = delay_s,
-                SimEffect::RateLimit { rate_degps } => {
-                    act.slew = act.slew.min(rate_degps.to_radians());
-                }
-                SimEffect::Saturation { limit_deg } => {
-                    act.limit = act.limit.min(limit_deg.to_radians());
-                }
-                SimEffect::DeadBand { width_deg } => act.band = width_deg.to_radians(),
-                SimEffect::Asymmetry { starboard_gain } => asym = starboard_gain,
-                SimEffect::NonlinearDamping { n_rr, cubic } => {
-                    p.n_rr = n_rr;
-                    p.cubic = cubic;
-                }
-                SimEffect::Wind {
-                    speed_mps,
-                    from_deg,
-                } => {
-                    let a = from_deg.to_radians();
-                    p.wind_ne = (-speed_mps * a.cos(), -speed_mps * a.sin());
-                }
-                SimEffect::Current {
-                    speed_mps,
-                    towards_deg,
-                } => {
-                    let a = towards_deg.to_radians();
-                    p.current_ne = (speed_mps * a.cos(), speed_mps * a.sin());
-                }
-            }
-        }
-        (p, act, asym)
+        p.bias_nm = k.yaw_moment_nm;
+        p.gyro_bias = k.gyro_bias_degps;
+        p.n_rr = k.n_rr;
+        p.cubic = k.cubic;
+        p.wind_ne = k.wind_ne;
+        p.current_ne = k.current_ne;
+        (p, act, k.starboard_gain)
     }
 
     /// Current and (gusting) true wind in body axes at heading ψ.

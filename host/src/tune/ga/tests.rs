@@ -4,11 +4,11 @@ use super::*;
 use crate::identify::model::Effect;
 use crate::identify::pem::testdata;
 
-/// Synthetic "simulator": the known 4th-order model; trials add a rate limit on the
-/// pods (hidden) and more noise.
+/// Synthetic "simulator": the known 4th-order model; trials add a dead time of the pods
+/// (hidden) and more noise.
 fn scenario(records: usize, len: usize) -> (Vec<Record>, Vec<Record>) {
     let t = testdata::truth();
-    let hidden = t.clone().with_effect(Effect::RateLimit { rate: 3.0 });
+    let hidden = t.clone().with_effect(Effect::DeadTime { samples: 2 });
     let mut sim = Vec::new();
     let mut trials = Vec::new();
     for i in 0..records as u64 {
