@@ -891,6 +891,34 @@ fn diagnose_names_a_hidden_dead_time_and_writes_stable_json() {
     assert!(v["after"]["fit"]["10"].as_f64() > v["before"]["fit"]["10"].as_f64());
     assert!(v["explanation"].as_str().unwrap().contains("dead time"));
     assert!(d.join("plots/diagnose_evidence.svg").exists());
+    // without --seed the seed comes from the records: two runs, the same seed and verdict
+    let unseeded = |json: &str| {
+        let p = d.join(json);
+        let o = run(&[
+            "diagnose",
+            "--model",
+            &s("model.postcard"),
+            "--data",
+            &s("trial-1.csv"),
+            "--reference",
+            &s("ref-1.csv"),
+            "--null-reps",
+            "8",
+            "--no-confirm",
+            "--json",
+            p.to_str().unwrap(),
+        ]);
+        assert_eq!(code(&o), 0, "{}", stderr(&o));
+        assert!(stderr(&o).contains("(from the records"), "{}", stderr(&o));
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+        (
+            v["seed"].clone(),
+            v["verdict"].clone(),
+            v["ranking"].clone(),
+        )
+    };
+    assert_eq!(unseeded("again-1.json"), unseeded("again-2.json"));
     // bad input: a record at another sample time, exit 2 naming the file
     let bad = d.join("bad.csv");
     std::fs::write(&bad, csv_text(400, 0.5)).unwrap();

@@ -256,7 +256,7 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
     let est = read_checked(&args.read, &args.data, &given)?;
     let val = read_checked(&args.read, &args.validate, &given)?;
     let reference = read_checked(&args.read, &args.reference, &given)?;
-    let seed = args.seed.resolve();
+    let seed = args.seed.resolve_for(&[&reference, &est, &val]);
     let (kind, auto, model) = match wanted {
         Wanted::Named(k) => (Some(k), false, given.clone()),
         Wanted::Nothing => (None, false, given.clone()),
