@@ -52,7 +52,10 @@
 //!   effects the yaw prediction cannot see well, when its own channel shows it (heading for
 //!   a gyro bias, speed over ground for current and wind). An effect that speed over ground
 //!   alone shows (no heading-dependent yaw moment) and that buys no held-out yaw-rate
-//!   prediction is not named ahead of a significant effect that does. The verdict's effect
+//!   prediction is not named ahead of a significant effect that does; and, the one ranking
+//!   rule above the statistics, no effect whose held-out gain is below 0.5 pp is named ahead
+//!   of a significant one whose gain is 1 pp or more (a sensor offset with nothing to win
+//!   back becomes a note behind it). The verdict's effect
 //!   is then refitted with the model ([`crate::diagnose::augment::augment`]) for the before/after fits.
 //! - **Current or wind.** A uniform current carries the ship: speed over ground varies with
 //!   heading by the current's speed (first harmonic), but the hull sees the same water
@@ -96,8 +99,8 @@ use evidence::{grid, world, Set};
 use null::bootstrap;
 use reference::{foreign, reference_actuator};
 use verdict::{
-    caveats, cfg_m, effect_evidence, frozen_gain, rank, ranked, split, verdict_words,
-    yaw_before_speed, Evidence,
+    caveats, cfg_m, effect_evidence, frozen_gain, gain_before_statistic, rank, ranked, split,
+    verdict_words, yaw_before_speed, Evidence,
 };
 
 pub use crate::io::data::{heading_bias, HeadingBias};
@@ -395,6 +398,7 @@ pub fn diagnose(
         })
         .collect();
     yaw_before_speed(&mut ev, &mut gains);
+    let passed_over = gain_before_statistic(&mut ev, &mut gains);
     bar.inc(1);
     bar.set_message("refit with the verdict's effect");
     let (ranking, verdict) = ranked(&ev, &gains, level);
@@ -414,6 +418,17 @@ pub fn diagnose(
     bar.finish_and_clear();
     let (verdict_name, mut explanation, after, augment) =
         verdict_words(&ev, &ranking, verdict, has_ref, cfg.alpha, &before);
+    if let Some(k) = passed_over.filter(|k| k.name() != verdict_name) {
+        explanation.push_str(&format!(
+            " Note: {} ({}) is significant but does not improve held-out prediction; by the \
+             ranking rule no effect that does not improve prediction (< {} pp) is named ahead \
+             of one that does (≥ {} pp).",
+            effect_phrase(k),
+            k.name(),
+            verdict::NO_GAIN_PP,
+            verdict::GAIN_PP
+        ));
+    }
     caveats(
         &mut explanation,
         gear.as_ref().map(|g| g.words.as_str()),

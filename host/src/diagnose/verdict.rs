@@ -168,6 +168,51 @@ pub(super) fn yaw_before_speed(
     gains.insert(i, g);
 }
 
+/// Held-out gain (pp) below which an effect counts as not improving prediction, for
+/// [`gain_before_statistic`].
+pub(super) const NO_GAIN_PP: f64 = 0.5;
+/// Held-out gain (pp) at and above which an effect counts as improving prediction.
+pub(super) const GAIN_PP: f64 = 1.0;
+
+/// The ranking rule the verdict states: an effect that does not improve held-out prediction
+/// (gain < [`NO_GAIN_PP`]) is never named ahead of a significant effect that does
+/// (≥ [`GAIN_PP`]), whatever their statistics — a sensor offset its own channel shows, with
+/// nothing to win back in the prediction, becomes a note behind the effect that does. The
+/// first such effect behind the first material one moves ahead of it (`gains[i]`: held-out
+/// gain and fits of the significant effects, in the order of `ev`). Returns the effect
+/// passed over, if any.
+pub(super) fn gain_before_statistic(
+    ev: &mut Vec<Evidence>,
+    gains: &mut Vec<Option<(f64, BTreeMap<String, f64>)>>,
+) -> Option<EffectKind> {
+    let gain = |g: &Option<(f64, BTreeMap<String, f64>)>| g.as_ref().map(|g| g.0);
+    let material = |e: &Evidence, g: &Option<(f64, BTreeMap<String, f64>)>| {
+        g.is_some() && (e.channel_material || gain(g).is_some_and(|v| v > 0.0))
+    };
+    let i = (0..ev.len()).find(|&i| material(&ev[i], &gains[i]))?;
+    let gi = gain(&gains[i]).unwrap_or(0.0);
+    if gi >= NO_GAIN_PP {
+        return None;
+    }
+    let j = (i + 1..ev.len()).find(|&j| gain(&gains[j]).is_some_and(|v| v >= GAIN_PP))?;
+    let gj = gain(&gains[j]).unwrap_or(0.0);
+    let words = format!(
+        "; named behind {} (a note, not the verdict): it improves held-out prediction by \
+         {gi:+.1} pp, where {} is significant and improves it by {gj:+.1} pp — an effect \
+         that does not improve prediction (< {NO_GAIN_PP} pp) is never named ahead of one \
+         that does (≥ {GAIN_PP} pp)",
+        ev[j].kind.name(),
+        ev[j].kind.name(),
+    );
+    ev[i].words.push_str(&words);
+    let passed = ev[i].kind;
+    let e = ev.remove(j);
+    ev.insert(i, e);
+    let g = gains.remove(j);
+    gains.insert(i, g);
+    Some(passed)
+}
+
 /// Current or wind, when speed over ground is logged (module docs): a uniform current carries
 /// the ship without a heading-dependent yaw moment, wind turns it. "Wind" nests "current"
 /// (the speed harmonics are free in both; wind adds the yaw-moment harmonics), so the

@@ -504,7 +504,7 @@ mod tests {
             .iter()
             .map(|u| s.actuator(&mut st, *u))
             .collect();
-        assert_eq!(outs, vec![0.0, 0.0, 0.0, 3.5, 3.5, 2.5, 3.5]);
+        assert_eq!(outs, vec![0.0, 0.0, 0.0, 3.5, 3.5, 2.5, 2.5]);
     }
 
     #[test]
