@@ -9,8 +9,8 @@ use yawcast_shared::model::EffectKind;
 /// Hidden `rate-limit` at full strength (deg/s); strength `s` gives `rate / s`.
 pub const HIDDEN_RATE_DEGPS: f64 = 3.0;
 
-/// The slowest and fastest gear searched (deg/s).
-const RATES: (f64, f64) = (0.5, 20.0);
+/// The slowest gear searched (deg/s).
+const SLOWEST: f64 = 0.5;
 
 pub(super) const DEF: Def = Def {
     kind: EffectKind::RateLimit,
@@ -31,17 +31,18 @@ pub(super) const DEF: Def = Def {
     search: |g| rates(g, 25),
 };
 
-/// The one grid of gear rates, diagnose's (`n` = 12) and augment's (25): geometric from
-/// 0.5 °/s to the rate that would still bind on the records' largest command step (90 % of
-/// it; a rate at or above it is no limit at all), at most 20 °/s.
+/// The one grid of gear rates, diagnose's (`n` = 12) and augment's (25; augment refines
+/// between the neighbours of the best): geometric from 0.5 °/s to 90 % of the rate of the
+/// records' largest command step — a gear at or above it is no limit at all on these
+/// commands.
 ///
 /// ```text
-/// du_max = 10°, ts = 1 s:  0.5 … 9 °/s;   du_max = 40°, ts = 0.5 s:  0.5 … 20 °/s
+/// du_max = 10°, ts = 1 s:  0.5 … 9 °/s;   du_max = 60°, ts = 0.4 s:  0.5 … 135 °/s
 /// ```
 fn rates(g: &GridSpan, n: usize) -> Vec<f64> {
-    let hi = (0.9 * g.du_max / g.ts).min(RATES.1).max(1.0);
-    let lo = RATES.0.min(hi / 2.0);
-    geometric(lo, hi, n)
+    let hi = (g.du_max / g.ts).max(1.0);
+    let lo = SLOWEST.min(hi / 2.0);
+    geometric(lo, 0.9 * hi, n)
 }
 
 pub(super) fn describe(rate: f64) -> String {
@@ -110,7 +111,7 @@ mod tests {
             du_max: 40.0,
             ..g
         };
-        assert!((rates(&g, 12)[11] - 20.0).abs() < 1e-9);
+        assert!((rates(&g, 12)[11] - 72.0).abs() < 1e-9);
         // a step smaller than the slowest rate still gives a grid below it
         let g = GridSpan {
             ts: 1.0,
@@ -119,7 +120,7 @@ mod tests {
         };
         let r = rates(&g, 12);
         assert!(
-            (r[0] - 0.5).abs() < 1e-12 && (r[11] - 1.0).abs() < 1e-9,
+            (r[0] - 0.5).abs() < 1e-12 && (r[11] - 0.9).abs() < 1e-9,
             "{r:?}"
         );
     }

@@ -16,7 +16,8 @@
 //!    - *Actuator effects* (dead time d, gear rate ρ, angle limit δ_max, dead band b): a
 //!      grid of the structural parameter, the effect's own search
 //!      ([`crate::effects::Def::search`]: d = 1..=[`MAX_DEAD_TIME`] samples; ρ on a log grid
-//!      over 0.5–20 °/s, which covers real steering gears' 2.3–9 °/s; δ_max over the
+//!      from 0.5 °/s to what still binds on the records' largest command step — diagnose's
+//!      range, finer —, which covers real steering gears' 2.3–9 °/s; δ_max over the
 //!      quantiles of the recorded |δ|; b over 0.2–6°). Every grid value is scored cheaply with θ frozen (one-step cost
 //!      of the input and of the baseline model with the effect added) and once more after a
 //!      warm-started re-identification (θ frozen without the effect can miss a sharp optimum);
