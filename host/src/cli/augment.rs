@@ -226,6 +226,8 @@ fn cli_err(e: AugmentError) -> anyhow::Error {
 }
 
 /// Runs `yawcast augment`.
+///
+/// Long: the subcommand's steps in the order its outputs are written, each a few lines.
 pub fn run(args: &AugmentArgs) -> Result<()> {
     let wanted = parse_effect(&args.effect, args.more)?;
     let (_, twin) = export::paths(&args.out);

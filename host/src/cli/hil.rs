@@ -71,6 +71,9 @@ pub struct HilSummary {
 }
 
 /// Runs `hil`.
+///
+/// Long: the subcommand's steps (connect, load, stream, compare, report) in order, each a few
+/// lines.
 pub fn run(args: &HilArgs) -> Result<()> {
     Outputs::check(&[args.json.json.as_deref()])?;
     if !(1..=yawcast_shared::wire::MAX_HORIZON).contains(&args.horizon) {

@@ -195,6 +195,9 @@ pub struct IdentifySummary {
 }
 
 /// Runs `identify`.
+///
+/// Long: the subcommand's steps in the order its outputs are written (read, identify, offset,
+/// focus, report, write), each a few lines.
 pub fn identify(args: &IdentifyArgs) -> Result<()> {
     check_json_vs_out(args.out.as_deref(), &args.json)?;
     let [blob, twin] = model_paths(args.out.as_deref());
@@ -467,6 +470,8 @@ pub struct TuneArgs {
 }
 
 /// Runs `tune`.
+///
+/// Long: the subcommand's steps in the order its outputs are written, each a few lines.
 pub fn tune(args: &TuneArgs) -> Result<()> {
     check_json_vs_out(args.out.as_deref(), &args.json)?;
     let [blob, twin] = model_paths(args.out.as_deref());

@@ -143,6 +143,9 @@ fn numbered(out: &Path, i: usize, n: usize) -> PathBuf {
 }
 
 /// Runs `yawcast simulate`.
+///
+/// Long: the subcommand's checks and steps in the order its outputs are written, each a few
+/// lines.
 pub fn run(args: &SimulateArgs) -> Result<()> {
     for (flag, v) in [
         ("--gyro-noise", args.gyro_noise),

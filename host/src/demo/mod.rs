@@ -361,6 +361,8 @@ pub(crate) mod tests {
     use crate::identify::predict;
 
     /// A synthetic outcome with every section filled, for layout tests.
+    ///
+    /// Long: one table of the demo's figures, filled in the order the report prints them.
     pub(crate) fn sample() -> Outcome {
         let m = Model::new(
             0.5,

@@ -183,6 +183,9 @@ fn spinner(on: bool, msg: &str) -> indicatif::ProgressBar {
 /// [`DemoError`] naming the step that failed (bad settings, a simulator, identification,
 /// export or file error). A GA run in which every candidate is rejected is not an error:
 /// the conventional model goes on and the report says so.
+///
+/// Long: the demo is a script: its steps in the order of the story the report tells, each a
+/// few lines with its output.
 pub fn run(cfg: &DemoConfig, say: &mut dyn FnMut(&str)) -> Result<Outcome, DemoError> {
     let t0 = Instant::now();
     let mut timings: Vec<(String, f64)> = Vec::new();

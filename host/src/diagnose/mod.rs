@@ -270,6 +270,9 @@ pub enum DiagnoseError {
 /// let e = diagnose(&m, &[], &[], &[], &DiagnoseConfig::default()).unwrap_err();
 /// assert_eq!(e.to_string(), "no trial records given");
 /// ```
+///
+/// Long: the driver: the method's steps in the order the module docs give them, each a call to
+/// its own module.
 pub fn diagnose(
     model: &Model,
     reference: &[Record],

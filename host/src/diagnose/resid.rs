@@ -232,6 +232,9 @@ pub struct ResidReport {
 /// assert_eq!(rep.acf.values.len(), 26);
 /// assert_eq!(rep.ccf.lags.len(), 51);
 /// ```
+///
+/// Long: the residual tests one after another on the same residuals (whiteness,
+/// cross-correlation, regimes, worst windows).
 pub fn resid(model: &Model, data: &[Record], cfg: &ResidConfig) -> Result<ResidReport, InputError> {
     if cfg.max_lag == 0 || cfg.horizon == 0 || cfg.bins == 0 {
         return Err(InputError::Config(

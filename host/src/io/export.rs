@@ -307,6 +307,9 @@ pub fn export_with(
 /// assert_eq!(files[1].1.len(), rep.blob_len);
 /// assert!(!out.parent().unwrap().exists());
 /// ```
+///
+/// Long: the export's checks in the order they can fail (conversion, f32 validation, round
+/// trip, bit comparison with the firmware), each with its own error.
 pub fn prepare_with(
     model: &Model,
     out: &Path,

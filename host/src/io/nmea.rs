@@ -403,6 +403,9 @@ pub fn parse_nmea(
 }
 
 /// Pass 1: every line → items, checksums verified.
+///
+/// Long: one pass over the sentences with the per-talker state; each sentence type is a short
+/// arm.
 fn scan(text: &str, path: &Path, opts: &NmeaOptions) -> Result<Vec<(usize, Item)>, NmeaError> {
     let mut out = Vec::new();
     let has_hdt = text.contains("HDT,");
@@ -574,6 +577,9 @@ fn hms(t: f64) -> String {
 type Series = BTreeMap<Chan, Vec<(f64, f64, usize)>>;
 
 /// Pass 2: items → time-stamped series per channel.
+///
+/// Long: the timestamp rules of every sentence type side by side (date roll-over, gaps,
+/// back-steps), each a short arm with its own error.
 fn timestamp(
     items: &[(usize, Item)],
     path: &Path,

@@ -498,6 +498,9 @@ fn settle(mut rep: GaReport, trials: &[Record], cfg: &GaConfig) -> GaReport {
 }
 
 /// One GA run around one penalty centre (`cfg.centres[0]`, else `cfg.pem.nominal`).
+///
+/// Long: the generation loop (selection, crossover, mutation, evaluation, elitism, stopping)
+/// reads as the algorithm's pseudo-code.
 fn tune_one(
     sim: &[Record],
     trials: &[Record],

@@ -126,6 +126,9 @@ fn stable(model: &Model, params: &[f64]) -> bool {
 /// assert!(r.cost <= 1.0);
 /// assert_eq!(r.horizons, vec![1, 5]);
 /// ```
+///
+/// Long: one LM loop over the k-step errors with its damping, acceptance and stopping rules
+/// side by side; split, the loop's state would travel through many arguments.
 pub fn refine(
     recs: &[Record],
     start: &Model,

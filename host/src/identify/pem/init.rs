@@ -221,6 +221,9 @@ fn hankel_z(recs: &[Record], uts: &[Vec<f64>], i: usize, (ri, st): (usize, usize
 /// Every product is accumulated over the windows as they are read (`Z Zᵀ` and `Y_f Zᵀ`
 /// [`HANKEL_BLOCK`] columns at a time, the state sequence one window at a time in two
 /// passes), so memory does not grow with the records' length.
+///
+/// Long: the N4SID steps (Hankel products streamed, projection, SVD, A/C, then B/K by least
+/// squares) in their textbook order, each a few lines.
 pub(crate) fn subspace(
     recs: &[Record],
     uts: &[Vec<f64>],

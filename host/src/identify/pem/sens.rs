@@ -194,6 +194,8 @@ pub(crate) fn pass<S: Sink>(model: &Model, lay: &Layout, rec: &Record, x0: &[f64
     }
 }
 
+/// Long: the forward pass and its exact sensitivities must mirror the predictor step line by
+/// line; one body keeps the two in view together.
 fn pass_n<const N: usize, S: Sink>(
     model: &Model,
     lay: &Layout,

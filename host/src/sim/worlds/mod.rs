@@ -573,6 +573,8 @@ fn rudder_moment(hull: &dyn Hull, deg: f64) -> f64 {
     (rd - r0) / per_nm
 }
 
+/// Long: one integration loop with the weather, sensors and manoeuvre logic of each sample;
+/// splitting would pass the loop state around.
 fn simulate_hull(
     mut hull: Box<dyn Hull>,
     scenario: &Scenario,
