@@ -88,6 +88,7 @@ mod tests {
     use super::*;
     use crate::identify::model::Model;
     use crate::identify::predict;
+    use crate::identify::predict::tests::m4;
     use crate::io::data::Record;
 
     #[test]
@@ -144,16 +145,6 @@ mod tests {
             e.to_string().contains("effects[0] (rate-limit).rate_degps"),
             "{e}"
         );
-    }
-
-    fn m4() -> Model {
-        Model::new(
-            1.0,
-            vec![-0.2, 0.3, -0.1, 0.6],
-            vec![0.01, 0.03, 0.05, 0.02],
-            vec![0.8, 0.5, 0.3, 0.2],
-        )
-        .unwrap()
     }
 
     /// The f64 predictor's actuator chain: dead time, limit, then the gear moving at most

@@ -393,11 +393,12 @@ pub fn fit_at(model: &Model, rec: &Record, h: Horizon) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::identify::model::Effect;
 
-    fn m4() -> Model {
+    /// A stable 4th-order model the tests share.
+    pub(crate) fn m4() -> Model {
         Model::new(
             1.0,
             vec![-0.2, 0.3, -0.1, 0.6],
