@@ -876,6 +876,8 @@ fn diagnose_names_a_hidden_dead_time_and_writes_stable_json() {
     assert_eq!(v["verdict"], "dead-time");
     assert_eq!(v["seed"], 5);
     assert_eq!(v["reference_used"], true);
+    // references given, heading and speed logged, short records: nothing qualifies it
+    assert_eq!(v["caveats"], serde_json::json!([]), "{}", v["explanation"]);
     assert_eq!(v["ranking"][0]["effect"], "dead-time");
     assert!(v["ranking"][0]["p_value"].as_f64().unwrap() < 1e-3);
     assert!(v["ranking"][0]["statistic"].as_f64().unwrap() > 0.0);

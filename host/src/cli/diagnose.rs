@@ -72,6 +72,8 @@ pub struct DiagnoseSummary {
     pub reference_used: bool,
     /// The verdict in words.
     pub explanation: String,
+    /// What qualifies the verdict, typed (`{"caveat": "no-reference"}`, …).
+    pub caveats: Vec<yawcast::diagnose::Caveat>,
     /// The confirming refit's own explanation, when done.
     pub augment_explanation: Option<String>,
 }
@@ -143,6 +145,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
             },
             reference_used: d.reference_used,
             explanation: d.explanation.clone(),
+            caveats: d.caveats.clone(),
             augment_explanation: d.augment.as_ref().map(|a| a.explanation.clone()),
         },
     )?;

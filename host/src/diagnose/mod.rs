@@ -104,7 +104,7 @@ use verdict::{
 };
 
 pub use crate::io::data::{heading_bias, HeadingBias};
-pub use verdict::effect_phrase;
+pub use verdict::{effect_phrase, Caveat};
 pub use window::{window, WINDOW, WINDOW_BLOCK};
 
 /// Horizon (samples) of the prediction errors the slow effects are fitted on.
@@ -205,8 +205,10 @@ pub struct Diagnosis {
     pub verdict: String,
     /// Every library effect not already in the model, best first.
     pub ranking: Vec<Ranked>,
-    /// The verdict in physical words, with numbers.
+    /// The verdict in physical words, with numbers (the caveats' words at its end).
     pub explanation: String,
+    /// What qualifies the verdict, typed (the explanation words them).
+    pub caveats: Vec<Caveat>,
     /// Whether reference records were given.
     pub reference_used: bool,
     /// The confirming refit of the verdict's effect, when done.
@@ -229,7 +231,7 @@ impl Diagnosis {
     /// use yawcast::diagnose::Diagnosis;
     /// use yawcast_shared::model::EffectKind;
     /// let d = Diagnosis {
-    ///     verdict: "dead-time".into(), ranking: vec![], explanation: String::new(),
+    ///     verdict: "dead-time".into(), ranking: vec![], explanation: String::new(), caveats: vec![],
     ///     reference_used: true, augment: None, before: Default::default(), after: Default::default(),
     ///     reference_gear: None,
     /// };
@@ -421,29 +423,27 @@ pub fn diagnose(
     bar.finish_and_clear();
     let (verdict_name, mut explanation, after, augment) =
         verdict_words(&ev, &ranking, verdict, has_ref, cfg.alpha, &before);
-    if let Some(k) = passed_over.filter(|k| k.name() != verdict_name) {
-        explanation.push_str(&format!(
-            " Note: {} ({}) is significant but does not improve held-out prediction; by the \
-             ranking rule no effect that does not improve prediction (< {} pp) is named ahead \
-             of one that does (≥ {} pp).",
-            effect_phrase(k),
-            k.name(),
-            verdict::NO_GAIN_PP,
-            verdict::GAIN_PP
-        ));
-    }
-    caveats(
-        &mut explanation,
+    let mut caveats = caveats(
         gear.as_ref().map(|g| g.words.as_str()),
         &windows,
         has_ref,
         foreign_pct,
         &ch,
     );
+    if let Some(k) = passed_over.filter(|k| k.name() != verdict_name) {
+        caveats.push(Caveat::PassedOver {
+            effect: k.name().into(),
+        });
+    }
+    for c in &caveats {
+        explanation.push(' ');
+        explanation.push_str(&c.explain());
+    }
     Ok(Diagnosis {
         verdict: verdict_name,
         ranking,
         explanation,
+        caveats,
         reference_used: has_ref,
         augment,
         before,

@@ -4,6 +4,8 @@
 
 use std::collections::BTreeMap;
 
+use serde::Serialize;
+
 use yawcast_shared::model::EffectKind;
 
 use super::augment::AugmentReport;
@@ -524,63 +526,131 @@ pub(super) fn verdict_words(
     }
 }
 
-/// The explanation's closing sentences: the reference's own gear, the blocks of long
-/// records, and what weakens the evidence (no reference, a model that does not look
-/// identified from it, heading or speed over ground not logged).
+/// What the verdict rests on that weakens or qualifies it; [`Caveat::explain`] says it in
+/// words (the explanation appends them in this order).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "caveat", rename_all = "kebab-case")]
+pub enum Caveat {
+    /// The reference records show steering-gear dynamics of their own; the statistics were
+    /// measured against the reference model with them.
+    ReferenceGear {
+        /// The sentence naming the gear and its held-out fits.
+        words: String,
+    },
+    /// Long sets were diagnosed on blocks spread evenly over them.
+    Blocks {
+        /// Blocks of the trials (0: used whole).
+        trials: usize,
+        /// Of the reference.
+        reference: usize,
+        /// Of the held-out records.
+        held_out: usize,
+    },
+    /// No reference records: every statistic is judged against the model alone.
+    NoReference,
+    /// The model does not look identified from the reference records.
+    ForeignModel {
+        /// Its one-step error on the reference above the re-identified structure's (%).
+        excess_pct: f64,
+    },
+    /// Heading is not logged in every record.
+    NoHeading,
+    /// Speed over ground (or heading) is not logged in every record.
+    NoSpeedOverGround,
+    /// A significant effect that does not improve held-out prediction was named behind
+    /// the verdict by the ranking rule.
+    PassedOver {
+        /// Its name.
+        effect: String,
+    },
+}
+
+impl Caveat {
+    /// The caveat in words, as the explanation appends it.
+    ///
+    /// ```
+    /// use yawcast::diagnose::Caveat;
+    /// assert!(Caveat::NoReference.explain().starts_with("No reference records were given"));
+    /// ```
+    pub fn explain(&self) -> String {
+        match self {
+            Caveat::ReferenceGear { words } => words.trim().to_string(),
+            Caveat::Blocks {
+                trials,
+                reference,
+                held_out,
+            } => format!(
+                "Records of more than {WINDOW} samples per set are diagnosed on blocks of up to \
+                 {WINDOW_BLOCK} samples spread evenly over them ({trials} of the trials, \
+                 {reference} of the reference, {held_out} of the held-out records; 0: used whole)."
+            ),
+            Caveat::NoReference => "No reference records were given, so every statistic is \
+                judged against the model alone: hull nonlinearity the model never had shows up \
+                as an effect, and the verdict is weaker."
+                .into(),
+            Caveat::ForeignModel { excess_pct } => format!(
+                "The model does not look identified from the reference records: its one-step \
+                 error there is {excess_pct:.0} % above that of the same structure re-identified \
+                 on them, and it predicts the trials better than that model does. A model \
+                 identified or tuned on the trials has absorbed part of what they show (an \
+                 actuator limit above all), so the evidence is weaker; the strongest test uses \
+                 the model identified on the reference records."
+            ),
+            Caveat::NoHeading => "Heading is not logged in every record: a gyro bias cannot be \
+                told apart from a constant yaw moment (bias), and wind and current are tested on \
+                the heading integrated from the measured yaw rate, from an unknown start (0°) \
+                and drifting with any rate offset."
+                .into(),
+            Caveat::NoSpeedOverGround => "Speed over ground (or heading) is not logged in every \
+                record: current and wind are judged from the yaw rate alone and are hard to tell \
+                apart from a bias."
+                .into(),
+            Caveat::PassedOver { effect } => {
+                let kind = EffectKind::from_name(effect);
+                format!(
+                    "Note: {} ({effect}) is significant but does not improve held-out \
+                     prediction; by the ranking rule no effect that does not improve prediction \
+                     (< {NO_GAIN_PP} pp) is named ahead of one that does (≥ {GAIN_PP} pp).",
+                    kind.map_or("an effect", effect_phrase)
+                )
+            }
+        }
+    }
+}
+
+/// The caveats of a diagnosis, in the order the explanation gives them.
 pub(super) fn caveats(
-    explanation: &mut String,
     gear_words: Option<&str>,
     windows: &[Option<Vec<Record>>; 3],
     has_ref: bool,
     foreign_pct: Option<f64>,
     ch: &Channels,
-) {
-    let windowed = windows.iter().any(Option::is_some);
+) -> Vec<Caveat> {
+    let mut out = Vec::new();
     if let Some(w) = gear_words {
-        explanation.push_str(w);
+        out.push(Caveat::ReferenceGear { words: w.into() });
     }
-    if windowed {
+    if windows.iter().any(Option::is_some) {
         let count = |w: &Option<Vec<Record>>| w.as_ref().map_or(0, Vec::len);
-        explanation.push_str(&format!(
-            " Records of more than {WINDOW} samples per set are diagnosed on blocks of up to \
-             {WINDOW_BLOCK} samples spread evenly over them ({} of the trials, {} of the \
-             reference, {} of the held-out records; 0: used whole).",
-            count(&windows[0]),
-            count(&windows[1]),
-            count(&windows[2]),
-        ));
+        out.push(Caveat::Blocks {
+            trials: count(&windows[0]),
+            reference: count(&windows[1]),
+            held_out: count(&windows[2]),
+        });
     }
     if !has_ref {
-        explanation.push_str(
-            " No reference records were given, so every statistic is judged against the \
-             model alone: hull nonlinearity the model never had shows up as an effect, and the \
-             verdict is weaker.",
-        );
+        out.push(Caveat::NoReference);
     }
-    if let Some(pct) = foreign_pct {
-        explanation.push_str(&format!(
-            " The model does not look identified from the reference records: its one-step \
-             error there is {pct:.0} % above that of the same structure re-identified on them, \
-             and it predicts the trials better than that model does. A model identified or \
-             tuned on the trials has absorbed part of what they show (an actuator limit above \
-             all), so the evidence is weaker; the strongest test uses the model identified on \
-             the reference records."
-        ));
+    if let Some(excess_pct) = foreign_pct {
+        out.push(Caveat::ForeignModel { excess_pct });
     }
     if !ch.heading_ok {
-        explanation.push_str(
-            " Heading is not logged in every record: a gyro bias cannot be told apart from a \
-             constant yaw moment (bias), and wind and current are tested on the heading \
-             integrated from the measured yaw rate, from an unknown start (0°) and drifting \
-             with any rate offset.",
-        );
+        out.push(Caveat::NoHeading);
     }
     if !ch.speed_ok {
-        explanation.push_str(
-            " Speed over ground (or heading) is not logged in every record: current and wind \
-             are judged from the yaw rate alone and are hard to tell apart from a bias.",
-        );
+        out.push(Caveat::NoSpeedOverGround);
     }
+    out
 }
 
 /// Hold-out split: the last 30 % of each record (kept long enough for the slow horizon).
