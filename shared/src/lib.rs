@@ -11,6 +11,7 @@ extern crate std;
 pub mod blob;
 pub mod crc;
 pub mod model;
+pub mod nav;
 pub mod wire;
 
 #[cfg(test)]
