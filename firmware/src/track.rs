@@ -7,7 +7,8 @@
 //! one `f32` rounding per operation, no FMA. Sine and cosine of a heading come from
 //! [`sin_cos_deg`], an `f32`-only polynomial (libm's `sincosf` reduces its argument in `f64`,
 //! which the M4F emulates in software at about 2 000 instructions a call). `d_y` is the model's
-//! `gyro-bias` offset: "`− d_y`" is performed only when the model has one. Constants computed
+//! `gyro-bias` offset, `+0` without one (`x − (+0)` is `x` for every `x`, so the one code path
+//! equals skipping the subtraction). Constants computed
 //! once when the tracker is built: `kr = ts · (π/180)` (the constant rounded to `f32`),
 //! `kk = ts · κ`, `kl = ts · λ` (κ the sway, λ the speed loss of the [`TrackSpec`]).
 //!
@@ -35,7 +36,8 @@
 //!    gate → [`Correction::Gated`]; else `U = U + g_u · ((h_n · ν_n) + (h_e · ν_e))` and, with
 //!    the current, `c_n = c_n + g_c · ν_n`, `c_e = c_e + g_c · ν_e`;
 //! 3. position fix `m` (when given): not finite → `Rejected`; else `μ = m − p̂` per
-//!    component; beyond the gate → `Gated`; else `n = n + α · μ_n`, `e = e + α · μ_e`,
+//!    component; beyond the gate → `Gated`; else (when `α ≠ 0`) `n = n + α · μ_n`,
+//!    `e = e + α · μ_e`,
 //!    `U = U + k_u · ((h_n · μ_n) + (h_e · μ_e))`, with the current `c = c + k_c · μ` per
 //!    component (step 2's `U` and `c` are the ones used here, `h` is step 1's);
 //! 4. time update: `p̂ = dr(p̂, h, w, ts · U)` (with the `U`, `c` of step 3),
@@ -116,7 +118,7 @@ pub struct Tracker {
     kr: f32,
     kk: f32,
     kl: f32,
-    dy: Option<f32>,
+    dy: f32,
     st: TrackState,
 }
 
@@ -137,24 +139,24 @@ impl Tracker {
     /// ```
     /// use yawcast_firmware::{track::Tracker, PredictorError};
     /// use yawcast_shared::model::{ModelSpec, Units};
-    /// use yawcast_shared::nav::{TrackError, TrackSpec};
+    /// use yawcast_shared::nav::{TrackError, TrackField, TrackSpec};
     /// let m = ModelSpec::new(2, 1.0, &[-0.7, -1.5], &[0.1, -0.05], &[0.3, -0.2],
     ///                        Units::default(), &[]).unwrap();
     /// let mut track = TrackSpec::new(1.0, 2.0, true).unwrap();
     /// assert_eq!(Tracker::new(&m, &track).unwrap().state().speed, 2.0);
     /// track.gate_position = 0.0;
     /// assert_eq!(Tracker::new(&m, &track).unwrap_err(),
-    ///            PredictorError::InvalidTrack(TrackError::OutOfRange("gate_position")));
+    ///            PredictorError::InvalidTrack(TrackError::OutOfRange(TrackField::GatePosition)));
     /// ```
     pub fn new(model: &ModelSpec, track: &TrackSpec) -> Result<Tracker, PredictorError> {
         model.validate()?;
         track
             .validate(model.ts)
             .map_err(PredictorError::InvalidTrack)?;
-        let mut dy = None;
+        let mut dy = 0.0;
         for e in &model.effects {
             if let Effect::GyroBias { d_y } = *e {
-                dy = Some(d_y);
+                dy = d_y;
             }
         }
         Ok(Tracker {
@@ -181,10 +183,7 @@ impl Tracker {
     /// `rate − d_y`.
     #[inline(always)]
     fn minus_dy(&self, rate: f32) -> f32 {
-        match self.dy {
-            Some(d) => rate - d,
-            None => rate,
-        }
+        rate - self.dy
     }
 
     /// One sample: heading, navigation corrections, time update (module docs, steps 1–5).
@@ -221,51 +220,23 @@ impl Tracker {
         }
         let h = st.h;
         let w = self.minus_dy(rate);
-        let velocity = match nav.velocity {
-            None => Correction::Absent,
-            Some(v) if !(v[0].is_finite() && v[1].is_finite()) => Correction::Rejected,
-            Some(v) => {
-                let sw = sp.sway * w;
-                let uw = st.speed - sp.speed_loss * (w * w);
-                let nu_n = v[0] - (uw * h[0] - sw * h[1] + st.current[0]);
-                let nu_e = v[1] - (uw * h[1] + sw * h[0] + st.current[1]);
-                if !(abs(nu_n) <= sp.gate_velocity && abs(nu_e) <= sp.gate_velocity) {
-                    Correction::Gated
-                } else {
-                    st.speed = st.speed + sp.gain_speed * (h[0] * nu_n + h[1] * nu_e);
-                    if sp.current {
-                        st.current[0] = st.current[0] + sp.gain_current * nu_n;
-                        st.current[1] = st.current[1] + sp.gain_current * nu_e;
-                    }
-                    Correction::Applied
-                }
-            }
-        };
-        let fix = match nav.fix {
-            None => Correction::Absent,
-            Some(m) if !(m[0].is_finite() && m[1].is_finite()) => Correction::Rejected,
-            Some(m) => {
-                let mu_n = m[0] - st.pos[0];
-                let mu_e = m[1] - st.pos[1];
-                if !(abs(mu_n) <= sp.gate_position && abs(mu_e) <= sp.gate_position) {
-                    Correction::Gated
-                } else {
-                    st.pos[0] = st.pos[0] + sp.gain_position * mu_n;
-                    st.pos[1] = st.pos[1] + sp.gain_position * mu_e;
-                    st.speed = st.speed + sp.fix_speed * (h[0] * mu_n + h[1] * mu_e);
-                    if sp.current {
-                        st.current[0] = st.current[0] + sp.fix_current * mu_n;
-                        st.current[1] = st.current[1] + sp.fix_current * mu_e;
-                    }
-                    Correction::Applied
-                }
-            }
-        };
+        let sw = sp.sway * w;
+        let uw = st.speed - sp.speed_loss * (w * w);
+        let v_hat = [
+            uw * h[0] - sw * h[1] + st.current[0],
+            uw * h[1] + sw * h[0] + st.current[1],
+        ];
+        let gains = [0.0, sp.gain_speed, sp.gain_current];
+        let velocity = self.correct(&mut st, nav.velocity, v_hat, sp.gate_velocity, gains, h);
+        let gains = [sp.gain_position, sp.fix_speed, sp.fix_current];
+        let p_hat = st.pos;
+        let fix = self.correct(&mut st, nav.fix, p_hat, sp.gate_position, gains, h);
         let ku = self.ts * st.speed;
-        let (n, e) = self.dr(&st, st.pos[0], st.pos[1], st.h, w, ku);
-        st.pos = [n, e];
-        st.psi = st.psi + self.ts * w;
-        st.h = self.rot(st.h, w);
+        let mut k = [st.psi, st.h[0], st.h[1], st.pos[0], st.pos[1]];
+        self.advance(&st, &mut k, rate, ku);
+        st.psi = k[0];
+        st.h = [k[1], k[2]];
+        st.pos = [k[3], k[4]];
         let sum = st.psi + st.h[0] + st.h[1] + st.pos[0] + st.pos[1] + st.speed;
         let sum = sum + st.current[0] + st.current[1];
         let reset = !sum.is_finite();
@@ -275,6 +246,43 @@ impl Tracker {
             fix,
             reset,
         }
+    }
+
+    /// Steps 2 and 3 (module docs): the innovation `ν = m − m̂` of a measurement `m`, gated,
+    /// then `p̂ = p̂ + g_p·ν` (only when `g_p ≠ 0`: the velocity has none),
+    /// `U = U + g_u·((h_n·ν_n) + (h_e·ν_e))`, and with the current `c = c + g_c·ν`;
+    /// `gains = [g_p, g_u, g_c]`. Out of line: both corrections share one copy.
+    #[inline(never)]
+    fn correct(
+        &self,
+        st: &mut TrackState,
+        m: Option<[f32; 2]>,
+        m_hat: [f32; 2],
+        gate: f32,
+        gains: [f32; 3],
+        h: [f32; 2],
+    ) -> Correction {
+        let Some(m) = m else {
+            return Correction::Absent;
+        };
+        if !(m[0].is_finite() && m[1].is_finite()) {
+            return Correction::Rejected;
+        }
+        let nu = [m[0] - m_hat[0], m[1] - m_hat[1]];
+        if !(abs(nu[0]) <= gate && abs(nu[1]) <= gate) {
+            return Correction::Gated;
+        }
+        if gains[0] != 0.0 {
+            st.pos = [st.pos[0] + gains[0] * nu[0], st.pos[1] + gains[0] * nu[1]];
+        }
+        st.speed = st.speed + gains[1] * (h[0] * nu[0] + h[1] * nu[1]);
+        if self.spec.current {
+            st.current = [
+                st.current[0] + gains[2] * nu[0],
+                st.current[1] + gains[2] * nu[1],
+            ];
+        }
+        Correction::Applied
     }
 
     /// `dr(p, h, w, k_u)` (module docs) with the current of `st`.
@@ -349,12 +357,28 @@ impl Tracker {
             psi = psi + self.ts * w;
             h = self.rot(h, w);
             *o = [psi, n, e];
+            // a second exit keeps the loop one copy in flash (runtime unrolling needs one)
+            if !e.is_finite() {
+                return Err(PredictorError::NonFinite);
+            }
         }
-        if psi.is_finite() && n.is_finite() && e.is_finite() {
+        if psi.is_finite() && n.is_finite() {
             Ok(())
         } else {
             Err(PredictorError::NonFinite)
         }
+    }
+
+    /// The time update of [`Tracker::update`] on `k = [ψ̂, h_n, h_e, n, e]` with yaw rate `r`
+    /// (before `− d_y`): the same steps as one step of the prediction.
+    #[inline(always)]
+    fn advance(&self, st: &TrackState, k: &mut [f32; 5], r: f32, ku: f32) {
+        let w = self.minus_dy(r);
+        let h = [k[1], k[2]];
+        let (n, e) = self.dr(st, k[3], k[4], h, w, ku);
+        let psi = k[0] + self.ts * w;
+        let h = self.rot(h, w);
+        *k = [psi, h[0], h[1], n, e];
     }
 
     /// A copy of the state.
@@ -469,14 +493,14 @@ pub fn ground_velocity(sog: f32, cog_deg: f32) -> [f32; 2] {
 /// ignored like a missing one.
 pub const MAX_HEADING: f32 = 1.0e6;
 
-/// `(sin x, cos x)` of an angle `x` in degrees, in `f32` only: `k = roundf(x / 90)` (as
-/// `x · (1/90)`, the constant rounded to `f32`), `r = (x − k·90) · (π/180)` in [−π/4, π/4]
-/// (`x − k·90` is exact for |x| ≤ [`MAX_HEADING`]), then with `r2 = r · r` the Taylor
-/// polynomials `s = r + r·(r2·(−1/6 + r2·(1/120 + r2·(−1/5040))))` and
+/// `(sin x, cos x)` of an angle `x` in degrees, in `f32` only: with `q = x · (1/90)` (the
+/// constant rounded to `f32`), the quadrant `k = (q + 0.5) as i32` for `q ≥ 0`, else
+/// `(q − 0.5) as i32` (truncating), `r = (x − k·90) · (π/180)` in [−π/4, π/4] up to a
+/// rounding (`x − k·90` is exact for |x| ≤ [`MAX_HEADING`]), then with `r2 = r · r` the
+/// Taylor polynomials `s = r + r·(r2·(−1/6 + r2·(1/120 + r2·(−1/5040))))` and
 /// `c = 1 + r2·(−1/2 + r2·(1/24 + r2·(−1/720 + r2·(1/40320))))` (each constant rounded to
-/// `f32`; errors below 4e-7), and the quadrant `k mod 4` picks `(s, c)`, `(c, −s)`,
-/// `(−s, −c)` or `(−c, s)`. Beyond ±[`MAX_HEADING`], and for NaN, the result is
-/// `(NaN, NaN)`.
+/// `f32`; errors below 4e-7), and `k mod 4` picks `(s, c)`, `(c, −s)`, `(−s, −c)` or
+/// `(−c, s)`. Beyond ±[`MAX_HEADING`], and for NaN, the result is `(NaN, NaN)`.
 ///
 /// # Errors
 /// None.
@@ -494,13 +518,18 @@ pub fn sin_cos_deg(x: f32) -> (f32, f32) {
     if x.is_nan() || abs(x) > MAX_HEADING {
         return (f32::NAN, f32::NAN);
     }
-    let k = libm::roundf(x * (1.0 / 90.0));
-    let r = (x - k * 90.0) * DEG2RAD;
+    let q = x * (1.0 / 90.0);
+    // |q| ≤ 11 112: the conversion neither saturates nor loses the integer
+    let ki = if q < 0.0 {
+        (q - 0.5) as i32
+    } else {
+        (q + 0.5) as i32
+    };
+    let r = (x - ki as f32 * 90.0) * DEG2RAD;
     let r2 = r * r;
     let s = r + r * (r2 * (-1.0 / 6.0 + r2 * (1.0 / 120.0 + r2 * (-1.0 / 5040.0))));
     let c = 1.0 + r2 * (-0.5 + r2 * (1.0 / 24.0 + r2 * (-1.0 / 720.0 + r2 * (1.0 / 40320.0))));
-    // `as` saturates (NaN gives 0): never panics
-    match (k as i32) & 3 {
+    match ki & 3 {
         0 => (s, c),
         1 => (c, -s),
         2 => (-s, -c),

@@ -56,12 +56,77 @@ pub struct TrackSpec {
     pub gate_position: f32,
 }
 
+/// A field of [`TrackSpec`], as named in errors.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TrackField {
+    /// `speed`.
+    Speed,
+    /// `sway`.
+    Sway,
+    /// `speed_loss`.
+    SpeedLoss,
+    /// `gain_speed`.
+    GainSpeed,
+    /// `gain_current`.
+    GainCurrent,
+    /// `gain_position`.
+    GainPosition,
+    /// `fix_speed`.
+    FixSpeed,
+    /// `fix_current`.
+    FixCurrent,
+    /// `gate_velocity`.
+    GateVelocity,
+    /// `gate_position`.
+    GatePosition,
+}
+
+impl TrackField {
+    /// Every field, in declaration order.
+    pub const ALL: [TrackField; 10] = [
+        TrackField::Speed,
+        TrackField::Sway,
+        TrackField::SpeedLoss,
+        TrackField::GainSpeed,
+        TrackField::GainCurrent,
+        TrackField::GainPosition,
+        TrackField::FixSpeed,
+        TrackField::FixCurrent,
+        TrackField::GateVelocity,
+        TrackField::GatePosition,
+    ];
+
+    /// The field's name in the model's JSON twin and in messages.
+    ///
+    /// # Errors
+    /// None.
+    ///
+    /// ```
+    /// use yawcast_shared::nav::TrackField;
+    /// assert_eq!(TrackField::GatePosition.name(), "gate_position");
+    /// ```
+    pub const fn name(self) -> &'static str {
+        match self {
+            TrackField::Speed => "speed",
+            TrackField::Sway => "sway",
+            TrackField::SpeedLoss => "speed_loss",
+            TrackField::GainSpeed => "gain_speed",
+            TrackField::GainCurrent => "gain_current",
+            TrackField::GainPosition => "gain_position",
+            TrackField::FixSpeed => "fix_speed",
+            TrackField::FixCurrent => "fix_current",
+            TrackField::GateVelocity => "gate_velocity",
+            TrackField::GatePosition => "gate_position",
+        }
+    }
+}
+
 /// Why a [`TrackSpec`] is not valid.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum TrackError {
-    /// A field is not finite or outside its range; the field's name.
-    OutOfRange(&'static str),
+    /// A field is not finite or outside its range.
+    OutOfRange(TrackField),
     /// A current gain is non-zero although the current is not estimated.
     CurrentGainWithoutCurrent,
 }
@@ -69,9 +134,11 @@ pub enum TrackError {
 impl core::fmt::Display for TrackError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
-            TrackError::OutOfRange(name) => {
-                write!(f, "track part: {name} is not finite or out of range")
-            }
+            TrackError::OutOfRange(field) => write!(
+                f,
+                "track part: {} is not finite or out of range",
+                field.name()
+            ),
             TrackError::CurrentGainWithoutCurrent => write!(
                 f,
                 "track part: current gains must be zero when the current is not estimated"
@@ -88,7 +155,8 @@ impl TrackSpec {
     /// `k_c = 0.002/Ts` with the current (else 0), gates 3 m/s and 200 m.
     ///
     /// # Errors
-    /// [`TrackError::OutOfRange`] when `speed` or `ts` is not finite or out of range.
+    /// [`TrackError::OutOfRange`] when `speed` (or `ts`, reported as the speed) is not finite
+    /// or out of range.
     ///
     /// ```
     /// use yawcast_shared::nav::TrackSpec;
@@ -99,7 +167,7 @@ impl TrackSpec {
     /// ```
     pub fn new(ts: f32, speed: f32, current: bool) -> Result<TrackSpec, TrackError> {
         if !(ts.is_finite() && ts > 0.0) {
-            return Err(TrackError::OutOfRange("ts"));
+            return Err(TrackError::OutOfRange(TrackField::Speed));
         }
         let c = if current { 1.0 } else { 0.0 };
         let spec = TrackSpec {
@@ -126,37 +194,37 @@ impl TrackSpec {
     /// [`TrackError::CurrentGainWithoutCurrent`].
     ///
     /// ```
-    /// use yawcast_shared::nav::{TrackError, TrackSpec};
+    /// use yawcast_shared::nav::{TrackError, TrackField, TrackSpec};
     /// let mut t = TrackSpec::new(0.5, 2.0, false).unwrap();
     /// t.gain_speed = 1.5;
-    /// assert_eq!(t.validate(0.5), Err(TrackError::OutOfRange("gain_speed")));
+    /// assert_eq!(t.validate(0.5), Err(TrackError::OutOfRange(TrackField::GainSpeed)));
+    /// assert_eq!(t.validate(0.5).unwrap_err().to_string(),
+    ///            "track part: gain_speed is not finite or out of range");
     /// ```
     pub fn validate(&self, ts: f32) -> Result<(), TrackError> {
-        fn within(v: f32, lo: f32, hi: f32) -> bool {
-            v.is_finite() && v >= lo && v <= hi
-        }
+        // one table, one loop: the controller carries this check, and it is small this way
         let inv_ts = 1.0 / ts;
-        let checks: [(&'static str, bool); 10] = [
-            ("speed", within(self.speed, 0.0, MAX_SPEED)),
-            ("sway", within(self.sway, -100.0, 100.0)),
-            ("speed_loss", within(self.speed_loss, -100.0, 100.0)),
-            ("gain_speed", within(self.gain_speed, 0.0, 1.0)),
-            ("gain_current", within(self.gain_current, 0.0, 1.0)),
-            ("gain_position", within(self.gain_position, 0.0, 1.0)),
-            ("fix_speed", within(self.fix_speed, 0.0, inv_ts)),
-            ("fix_current", within(self.fix_current, 0.0, inv_ts)),
-            (
-                "gate_velocity",
-                within(self.gate_velocity, f32::MIN_POSITIVE, 1.0e3),
-            ),
-            (
-                "gate_position",
-                within(self.gate_position, f32::MIN_POSITIVE, 1.0e7),
-            ),
+        let value = [
+            self.speed,
+            self.sway,
+            self.speed_loss,
+            self.gain_speed,
+            self.gain_current,
+            self.gain_position,
+            self.fix_speed,
+            self.fix_current,
+            self.gate_velocity,
+            self.gate_position,
         ];
-        for (name, ok) in checks {
-            if !ok {
-                return Err(TrackError::OutOfRange(name));
+        let tiny = f32::MIN_POSITIVE;
+        let lo = [0.0, -100.0, -100.0, 0.0, 0.0, 0.0, 0.0, 0.0, tiny, tiny];
+        let hi = [
+            MAX_SPEED, 100.0, 100.0, 1.0, 1.0, 1.0, inv_ts, inv_ts, 1.0e3, 1.0e7,
+        ];
+        for i in 0..TrackField::ALL.len() {
+            // NaN fails both comparisons
+            if !(value[i] >= lo[i] && value[i] <= hi[i]) {
+                return Err(TrackError::OutOfRange(TrackField::ALL[i]));
             }
         }
         if !self.current && (self.gain_current != 0.0 || self.fix_current != 0.0) {

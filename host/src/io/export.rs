@@ -28,7 +28,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 use yawcast_firmware::PredictorError;
-use yawcast_shared::blob::{self, FORMAT_VERSION, MAX_BLOB_LEN};
+use yawcast_shared::blob::{self, MAX_BLOB_LEN, MODEL_ONLY_VERSION};
 use yawcast_shared::model::ModelSpec;
 
 use crate::identify::model::Model;
@@ -393,7 +393,7 @@ pub fn prepare_with(
     let json = ModelJson {
         format: "yawcast-model".into(),
         format_version: JSON_FORMAT_VERSION,
-        blob_format_version: FORMAT_VERSION,
+        blob_format_version: MODEL_ONLY_VERSION,
         model: model.clone(),
         param_names: model.param_names(),
         check_record: check.name.clone(),
