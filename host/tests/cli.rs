@@ -728,7 +728,8 @@ fn simulate_writes_seeded_records_with_the_effect_and_the_ship_file() {
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     assert!(stderr(&o).contains("seed 11"));
     let first = std::fs::read_to_string(d.join("trial-1.csv")).unwrap();
-    assert!(first.starts_with("t_s,delta_deg,r_degps,psi_deg,u_mps\n"));
+    // the built-in ship also logs course over ground and position
+    assert!(first.starts_with("t_s,delta_deg,r_degps,psi_deg,u_mps,cog_deg,north_m,east_m\n"));
     assert_eq!(first.lines().count(), 301);
     // Same seed, same bytes; the second record has the next seed.
     let again = d.join("again.csv");

@@ -56,7 +56,15 @@ fn reference_model(ship: &Ship) -> (Model, TrackSpec, TrackSpec) {
 }
 
 fn eval(model: &Model, track: &TrackSpec, rec: &Record, nav: &Nav) -> TrackEval {
-    evaluate(model, track, rec, nav, &[10, 20], &[30.0, 60.0, 120.0]).expect("evaluation")
+    evaluate(
+        model,
+        track,
+        rec,
+        Some(nav),
+        &[10, 20],
+        &[30.0, 60.0, 120.0],
+    )
+    .expect("evaluation")
 }
 
 fn err60(e: &TrackEval) -> f64 {

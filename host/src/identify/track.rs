@@ -236,7 +236,8 @@ pub struct TrackEval {
 }
 
 /// Evaluates the model's heading and track prediction on `rec` with navigation data `nav`:
-/// heading fit at `heading_steps` (needs a logged heading), track error at `track_secs`.
+/// heading fit at `heading_steps` (needs a logged heading), track error at `track_secs`
+/// (only with `nav`; without it the track errors are `None`).
 ///
 /// # Errors
 /// A message when the record has no heading (the heading is where the track starts from).
@@ -244,7 +245,7 @@ pub fn evaluate(
     model: &Model,
     track: &TrackSpec,
     rec: &Record,
-    nav: &Nav,
+    nav: Option<&Nav>,
     heading_steps: &[usize],
     track_secs: &[f64],
 ) -> Result<TrackEval, String> {
@@ -285,7 +286,12 @@ pub fn evaluate(
     for t in 0..n {
         let yhat = stepper.output(&st);
         let y_used = if rec.y[t].is_finite() { rec.y[t] } else { yhat };
-        let (v, f, origin, reset) = tr.update(y_used, Some(psi[t]), nav.velocity(t), nav.fix(t));
+        let (v, f, origin, reset) = tr.update(
+            y_used,
+            Some(psi[t]),
+            nav.and_then(|n| n.velocity(t)),
+            nav.and_then(|n| n.fix(t)),
+        );
         count(v, &mut vc);
         count(f, &mut fc);
         resets += usize::from(reset);
@@ -312,12 +318,15 @@ pub fn evaluate(
                 psi_rate[i][t + k] = p;
             }
         }
-        if let Some(reference) = nav.reference() {
+        if let Some(reference) = nav.and_then(Nav::reference) {
             for (i, &k) in track_steps.iter().enumerate() {
                 if k <= last {
                     let dn = (pred[k - 1][1] - origin[0]) - (reference[t + k][0] - reference[t][0]);
                     let de = (pred[k - 1][2] - origin[1]) - (reference[t + k][1] - reference[t][1]);
-                    errs[i].push(dn.hypot(de));
+                    let d = dn.hypot(de);
+                    if d.is_finite() {
+                        errs[i].push(d);
+                    }
                 }
             }
         }

@@ -374,3 +374,34 @@ pub fn parse_nav_csv(
         &source.join(", "),
     ))
 }
+
+/// The measurement CSV of a record ([`csv_text`](crate::io::data::csv_text)) with the
+/// navigation columns `cog_deg,north_m,east_m` appended (one value per sample each).
+///
+/// ```
+/// use yawcast::io::{data::Record, nav::csv_text_with_nav};
+/// let r = Record::from_uy("r", 1.0, vec![0.0, 1.0], vec![0.5, 0.25]);
+/// let t = csv_text_with_nav(&r, &[359.5, 0.5], &[0.0, 1.0], &[0.0, -0.25]);
+/// assert_eq!(t, "t_s,delta_deg,r_degps,cog_deg,north_m,east_m\n0,0,0.5,359.5,0,0\n1,1,0.25,0.5,1,-0.25\n");
+/// ```
+pub fn csv_text_with_nav(
+    rec: &crate::io::data::Record,
+    cog_deg: &[f64],
+    north_m: &[f64],
+    east_m: &[f64],
+) -> String {
+    let base = crate::io::data::csv_text(rec);
+    let mut out = String::with_capacity(base.len() + 32 * rec.len());
+    for (i, line) in base.lines().enumerate() {
+        out.push_str(line);
+        if i == 0 {
+            out.push_str(",cog_deg,north_m,east_m");
+        } else {
+            let j = i - 1;
+            let at = |v: &[f64]| v.get(j).copied().unwrap_or(f64::NAN);
+            out.push_str(&format!(",{},{},{}", at(cog_deg), at(north_m), at(east_m)));
+        }
+        out.push('\n');
+    }
+    out
+}
