@@ -292,19 +292,12 @@ impl ReadArgs {
     }
 
     /// The navigation channels of the record `rec` read from `path` (speed and course over
-    /// ground, positions): `Ok(None)` with a note when the file has none, when it is an NMEA
-    /// log or when it was resampled (the heading and track prediction is then skipped, never
-    /// guessed).
+    /// ground, positions): `Ok(None)` when the file has none, when it is an NMEA log or when
+    /// it was resampled (the heading and track prediction is then skipped, never guessed;
+    /// the caller says so).
     ///
     /// Errors name the file, row and column (bad input).
     pub fn read_nav(&self, path: &Path, rec: &Record) -> Result<Option<Nav>> {
-        let note = |why: &str| {
-            eprintln!(
-                "note: {}: {why}: heading and track prediction skipped for this record",
-                path.display()
-            );
-            Ok(None)
-        };
         let bytes = std::fs::read(path)
             .map_err(|e| bad(format!("{}: cannot read: {e}", path.display())))?;
         let text = String::from_utf8_lossy(&bytes);
@@ -320,17 +313,13 @@ impl ReadArgs {
                     || (ext != "csv" && nmea::looks_like_nmea(&text))
             }
         };
-        if is_nmea {
-            return note("navigation sentences of NMEA logs are not read yet");
+        // NMEA navigation sentences are not read yet, and resampled records have no rows
+        // to match the navigation cells to
+        if is_nmea || self.resample.is_some() {
+            return Ok(None);
         }
-        if self.resample.is_some() {
-            return note("navigation channels are not resampled (--resample)");
-        }
-        match parse_nav_csv(&text, path, &self.nav_columns(), rec.len(), rec.ts) {
-            Ok(Some(nav)) => Ok(Some(nav)),
-            Ok(None) => note("no course over ground or position columns"),
-            Err(e) => Err(bad(e.to_string())),
-        }
+        parse_nav_csv(&text, path, &self.nav_columns(), rec.len(), rec.ts)
+            .map_err(|e| bad(e.to_string()))
     }
 
     /// Reads several record files, in order.

@@ -112,19 +112,10 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     let track = read_track(&args.model, &model)?;
     let horizons = parse_horizons(&args.horizons)?;
     let mut records = Vec::new();
-    let mut navs = Vec::new();
     for p in &args.data {
         let rec = args.read.read(p)?;
         check_record_for_model(&rec, &model, p)?;
-        navs.push(args.read.read_nav(p, &rec)?);
         records.push(rec);
-    }
-    if track.is_none() && navs.iter().any(Option::is_some) {
-        eprintln!(
-            "note: {}: the model has no heading/track part (identify it from records with \
-             speed and course over ground): no track error",
-            args.model.display()
-        );
     }
     if args.out.is_some() {
         // One series file per record, named after it: two records of one name would share it.
@@ -165,6 +156,23 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     };
     let mut out = Vec::new();
     let mut series = Vec::new();
+    let mut navs = Vec::new();
+    for (rec, p) in records.iter().zip(&args.data) {
+        navs.push(args.read.read_nav(p, rec)?);
+    }
+    let without = navs.iter().filter(|n| n.is_none()).count();
+    if track.is_none() && without < navs.len() {
+        eprintln!(
+            "note: {}: the model has no heading/track part (identify it from records with \
+             speed and course over ground): no track error",
+            args.model.display()
+        );
+    } else if track.is_some() && without > 0 {
+        eprintln!(
+            "note: {without} record(s) without speed and course over ground or positions \
+             (or NMEA logs, whose navigation sentences are not read yet): no track error for them"
+        );
+    }
     let steps: Vec<usize> = horizons
         .iter()
         .filter_map(|h| match h {
