@@ -451,3 +451,7 @@ pub fn fit_track(
     spec.validate(ts as f32).map_err(|e| e.to_string())?;
     Ok(spec)
 }
+
+#[cfg(test)]
+#[path = "track_tests.rs"]
+mod tests;
