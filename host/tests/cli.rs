@@ -2399,6 +2399,23 @@ fn navigation_input_errors_name_row_and_column_and_jumps_are_counted() {
     assert!(e30 < 1.0, "median 30-s track error {e30} m");
     // (a constant heading has no spread to score a fit against, but the key is there)
     assert!(r["heading_fit"].is_object());
+    // export carries the track part into a format 3 blob and the twin
+    let o = run(&[
+        "export",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        d.join("nav.csv").to_str().unwrap(),
+        "--out",
+        d.join("exp").to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let blob = std::fs::read(d.join("exp.postcard")).unwrap();
+    assert_eq!(&blob[4..6], &[3, 0]);
+    let twin: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("exp.json")).unwrap()).unwrap();
+    assert_eq!(twin["blob_format_version"], 3);
+    assert_eq!(twin["track"]["gate_position"], 200.0);
     // bad cells: the error names file, row and column
     for (name, header, cell, want) in [
         (

@@ -851,8 +851,10 @@ pub fn export_cmd(args: &ExportArgs) -> Result<()> {
     let model = read_model(&args.model)?;
     let check = args.read.read(&args.data)?;
     super::common::check_record_for_model(&check, &model, &args.data)?;
+    // the model's heading/track part goes into the blob with it (format 3)
     let cfg = export::ExportConfig {
         golden: args.golden.clone(),
+        track: super::common::read_track(&args.model, &model)?,
         ..export::ExportConfig::default()
     };
     let (r, files) =
