@@ -292,9 +292,9 @@ impl ReadArgs {
     }
 
     /// The navigation channels of the record `rec` read from `path` (speed and course over
-    /// ground, positions): `Ok(None)` when the file has none, when it is an NMEA log or when
-    /// it was resampled (the heading and track prediction is then skipped, never guessed;
-    /// the caller says so).
+    /// ground, positions; from CSV columns or NMEA `VTG`, `RMC`, `GGA`): `Ok(None)` when the
+    /// file has none or was resampled (the heading and track prediction is then skipped,
+    /// never guessed; the caller says so).
     ///
     /// Errors name the file, row and column (bad input).
     pub fn read_nav(&self, path: &Path, rec: &Record) -> Result<Option<Nav>> {
@@ -313,9 +313,13 @@ impl ReadArgs {
                     || (ext != "csv" && nmea::looks_like_nmea(&text))
             }
         };
-        // NMEA navigation sentences are not read yet, and resampled records have no rows
-        // to match the navigation cells to
-        if is_nmea || self.resample.is_some() {
+        if is_nmea {
+            let nn = nmea::parse_nmea_nav(&text, path, &self.nmea(), rec)
+                .map_err(|e| bad(e.to_string()))?;
+            return Ok(yawcast::io::nav::from_nmea(rec, &nn));
+        }
+        // resampled records have no rows to match the navigation cells to
+        if self.resample.is_some() {
             return Ok(None);
         }
         parse_nav_csv(&text, path, &self.nav_columns(), rec.len(), rec.ts)

@@ -169,8 +169,8 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         );
     } else if track.is_some() && without > 0 {
         eprintln!(
-            "note: {without} record(s) without speed and course over ground or positions \
-             (or NMEA logs, whose navigation sentences are not read yet): no track error for them"
+            "note: {without} record(s) without speed and course over ground or positions: no \
+             track error for them"
         );
     }
     let steps: Vec<usize> = horizons

@@ -405,3 +405,48 @@ pub fn csv_text_with_nav(
     }
     out
 }
+
+/// The navigation channels of an NMEA record: the ground velocity from its speed over ground
+/// (`VTG`) and the course (`VTG`, else `RMC`), the positions (`GGA`, else `RMC`) in metres
+/// about the first fix; `None` when the log has neither.
+///
+/// ```
+/// use yawcast::io::{data::Record, nav::from_nmea, nmea::NmeaNav};
+/// let mut r = Record::from_uy("r", 1.0, vec![0.0; 3], vec![0.0; 3]);
+/// r.speed = Some(vec![2.0; 3]);
+/// let nn = NmeaNav { course: Some(vec![90.0, f64::NAN, 90.0]), position: None };
+/// let nav = from_nmea(&r, &nn).unwrap();
+/// assert_eq!(nav.missing, 1);
+/// assert!((nav.velocity(0).unwrap()[1] - 2.0).abs() < 1e-12);
+/// ```
+pub fn from_nmea(rec: &crate::io::data::Record, nn: &crate::io::nmea::NmeaNav) -> Option<Nav> {
+    let velocity = match (&rec.speed, &nn.course) {
+        (Some(sog), Some(cog)) => Some(
+            sog.iter()
+                .zip(cog)
+                .map(|(s, c)| ground_velocity(*s, *c))
+                .collect::<Vec<_>>(),
+        ),
+        _ => None,
+    };
+    let fix = nn.position.as_ref().map(|p| {
+        let origin = p
+            .iter()
+            .find(|q| q[0].is_finite() && q[1].is_finite())
+            .copied();
+        p.iter()
+            .map(|q| match origin {
+                Some(o) if q[0].is_finite() && q[1].is_finite() => local_metres(o, *q),
+                _ => [f64::NAN, f64::NAN],
+            })
+            .collect::<Vec<_>>()
+    });
+    let mut source = Vec::new();
+    if velocity.is_some() {
+        source.push("VTG speed and course");
+    }
+    if fix.is_some() {
+        source.push("GGA/RMC positions");
+    }
+    Nav::new(rec.ts, velocity, fix, &source.join(", "))
+}
