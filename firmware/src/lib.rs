@@ -104,6 +104,8 @@ pub enum PredictorError {
     NonFinite,
     /// A state given to [`Predictor::restore`] is not finite or not consistent with the model.
     InvalidState,
+    /// The heading/track part of the model does not validate ([`track::Tracker::new`]).
+    InvalidTrack(yawcast_shared::nav::TrackError),
 }
 
 impl core::fmt::Display for PredictorError {
@@ -124,6 +126,7 @@ impl core::fmt::Display for PredictorError {
             PredictorError::InvalidState => {
                 write!(f, "state is non-finite or inconsistent with the model")
             }
+            PredictorError::InvalidTrack(e) => write!(f, "{e}"),
         }
     }
 }
@@ -634,6 +637,8 @@ impl<const N: usize> Predictor<N> {
         self.st = PredictorState::ZERO;
     }
 }
+
+pub mod track;
 
 #[cfg(test)]
 mod tests;

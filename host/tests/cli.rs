@@ -728,7 +728,8 @@ fn simulate_writes_seeded_records_with_the_effect_and_the_ship_file() {
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     assert!(stderr(&o).contains("seed 11"));
     let first = std::fs::read_to_string(d.join("trial-1.csv")).unwrap();
-    assert!(first.starts_with("t_s,delta_deg,r_degps,psi_deg,u_mps\n"));
+    // the built-in ship also logs course over ground and position
+    assert!(first.starts_with("t_s,delta_deg,r_degps,psi_deg,u_mps,cog_deg,north_m,east_m\n"));
     assert_eq!(first.lines().count(), 301);
     // Same seed, same bytes; the second record has the next seed.
     let again = d.join("again.csv");
@@ -2242,6 +2243,40 @@ fn exit_codes_follow_one_contract() {
     std::fs::write(d.join("file"), b"a file").unwrap();
     std::fs::create_dir_all(d.join("sub")).unwrap();
     std::fs::write(d.join("sub/short.csv"), csv_text(300, 0.5)).unwrap();
+    // navigation channels: good ones (courses through 360°), and four kinds of bad input
+    let nav = |cols: &str, cell: &dyn Fn(usize) -> String| {
+        let mut out = String::new();
+        for (i, line) in csv_text(300, 0.5).lines().enumerate() {
+            out.push_str(line);
+            out.push(',');
+            if i == 0 {
+                out.push_str(cols);
+            } else {
+                out.push_str(&cell(i));
+            }
+            out.push('\n');
+        }
+        out
+    };
+    type Cell<'a> = &'a dyn Fn(usize) -> String;
+    let files: [(&str, &str, Cell); 5] = [
+        ("nav-good.csv", "psi_deg,u_mps,cog_deg", &|i| {
+            format!("{},1.2,{}", 355 + i % 10, (355 + i % 10) % 360)
+        }),
+        ("nav-negative.csv", "u_mps,cog_deg", &|i| {
+            format!("{},10", if i == 7 { -0.5 } else { 1.0 })
+        }),
+        ("nav-text.csv", "u_mps,cog_deg", &|i| {
+            format!("1.0,{}", if i == 9 { "north" } else { "10" })
+        }),
+        ("nav-half.csv", "lat_deg", &|_| "60.0".to_string()),
+        ("nav-lat.csv", "lat_deg,lon_deg", &|i| {
+            format!("{},10.0", if i == 4 { 95.0 } else { 60.0 })
+        }),
+    ];
+    for (name, cols, cell) in files {
+        std::fs::write(d.join(name), nav(cols, cell)).unwrap();
+    }
     // A valid, stable model whose gain is 10⁴ times the records': its simulation runs off
     // the record (fit about −10⁶ %), a numerical failure, not a result to print.
     std::fs::write(
@@ -2269,6 +2304,11 @@ fn exit_codes_follow_one_contract() {
         ("compare, diverging model", 1, "compare --model {d}/wild.json --data {d}/short.csv --horizons sim"),
         ("compare, two records of one name", 2, "compare --model {model} --data {d}/short.csv --data {d}/sub/short.csv --out {d}/series2"),
         ("compare, missing model", 2, "compare --model {d}/nowhere.json --data {d}/short.csv"),
+        ("compare, navigation channels", 0, "compare --model {model} --data {d}/nav-good.csv"),
+        ("compare, negative speed over ground", 2, "compare --model {model} --data {d}/nav-negative.csv"),
+        ("compare, text as a course", 2, "compare --model {model} --data {d}/nav-text.csv"),
+        ("compare, latitude without longitude", 2, "compare --model {model} --data {d}/nav-half.csv"),
+        ("compare, latitude beyond 90°", 2, "compare --model {model} --data {d}/nav-lat.csv"),
         ("resid", 0, "resid --model {model} --data {d}/short.csv --out {d}/plots"),
         ("resid, --max-lag 0", 2, "resid --model {model} --data {d}/short.csv --max-lag 0"),
         ("diagnose, --alpha 2", 2, "diagnose --model {model} --data {d}/short.csv --alpha 2"),
@@ -2332,4 +2372,136 @@ fn exit_codes_follow_one_contract() {
     ] {
         assert!(!d.join(f).exists(), "{f} written by a refused run");
     }
+}
+
+/// Bad navigation input names its file, row and column; a position jump of kilometres and a
+/// NaN fix are skipped and counted, never followed.
+#[test]
+fn navigation_input_errors_name_row_and_column_and_jumps_are_counted() {
+    let d = scratch("nav-input");
+    // a model with a heading/track part (no current), as identify writes it into the twin
+    let m = d.join("m.json");
+    std::fs::write(
+        &m,
+        r#"{"model":{"n":2,"ts":0.5,"a":[-0.2,0.7],"b":[0.01,0.02],"k":[0.5,0.2],"effects":[]},
+           "track":{"speed":1.0,"sway":0.0,"speed_loss":0.0,"current":false,"gain_speed":0.05,
+                    "gain_current":0.0,"gain_position":0.5,"fix_speed":0.02,"fix_current":0.0,
+                    "gate_velocity":3.0,"gate_position":200.0}}"#,
+    )
+    .unwrap();
+    let mut rows = String::from("t_s,delta_deg,r_degps,psi_deg,u_mps,cog_deg,north_m,east_m\n");
+    for (i, line) in csv_text(400, 0.5).lines().skip(1).enumerate() {
+        let n = 0.5 * i as f64;
+        let (north, east) = match i {
+            150 => ("5000".to_string(), "0".to_string()),
+            200 => ("NaN".to_string(), "0".to_string()),
+            _ => (format!("{n}"), "0".to_string()),
+        };
+        rows.push_str(&format!(
+            "{line},0,1.0,{},{north},{east}\n",
+            if i % 2 == 0 { 359.5 } else { 0.5 }
+        ));
+    }
+    std::fs::write(d.join("nav.csv"), &rows).unwrap();
+    let js = d.join("c.json");
+    let o = run(&[
+        "compare",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        d.join("nav.csv").to_str().unwrap(),
+        "--json",
+        js.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("2 navigation correction(s) skipped"),
+        "{}",
+        stderr(&o)
+    );
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&js).unwrap()).unwrap();
+    let r = &j["records"][0];
+    assert_eq!(r["nav_skipped"]["fix_gated"], 1);
+    assert_eq!(r["nav_skipped"]["fix_rejected"], 1);
+    assert_eq!(r["nav_skipped"]["velocity_gated"], 0);
+    // straight north at 1 m/s: the track prediction follows it (the jump is not followed)
+    let e30 = r["track_error_m"]["30"].as_f64().unwrap();
+    assert!(e30 < 1.0, "median 30-s track error {e30} m");
+    // (a constant heading has no spread to score a fit against, but the key is there)
+    assert!(r["heading_fit"].is_object());
+    // export carries the track part into a format 3 blob and the twin
+    let o = run(&[
+        "export",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        d.join("nav.csv").to_str().unwrap(),
+        "--out",
+        d.join("exp").to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let blob = std::fs::read(d.join("exp.postcard")).unwrap();
+    assert_eq!(&blob[4..6], &[3, 0]);
+    let twin: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("exp.json")).unwrap()).unwrap();
+    assert_eq!(twin["blob_format_version"], 3);
+    assert_eq!(twin["track"]["gate_position"], 200.0);
+    // bad cells: the error names file, row and column
+    for (name, header, cell, want) in [
+        (
+            "neg.csv",
+            "u_mps,cog_deg",
+            "-0.5,10",
+            "row 3, column `u_mps`: speed over ground -0.5 m/s is negative",
+        ),
+        (
+            "text.csv",
+            "u_mps,cog_deg",
+            "1.0,north",
+            "row 3, column `cog_deg`: expected a number (or an empty cell), found `north`",
+        ),
+        (
+            "lat.csv",
+            "lat_deg,lon_deg",
+            "95,10",
+            "row 3, column `lat_deg`: latitude 95 is outside ±90°",
+        ),
+        (
+            "half.csv",
+            "north_m",
+            "1",
+            "column `north_m` is there but `east_m` is not",
+        ),
+    ] {
+        let mut t = String::new();
+        for (i, line) in csv_text(300, 0.5).lines().enumerate() {
+            let extra = match i {
+                0 => header.to_string(),
+                3 => cell.to_string(),
+                _ => cell
+                    .replace("-0.5", "1.0")
+                    .replace("north", "10")
+                    .replace("95", "60"),
+            };
+            t.push_str(&format!("{line},{extra}\n"));
+        }
+        let p = d.join(name);
+        std::fs::write(&p, t).unwrap();
+        let o = run(&[
+            "compare",
+            "--model",
+            m.to_str().unwrap(),
+            "--data",
+            p.to_str().unwrap(),
+        ]);
+        assert_eq!(code(&o), 2, "{name}: {}", stderr(&o));
+        let first = stderr(&o).lines().next().unwrap_or_default().to_string();
+        assert!(
+            first.starts_with("error: ") && first.contains(name),
+            "{name}: {first}"
+        );
+        assert!(first.contains(want), "{name}: {first}");
+    }
+    let _ = std::fs::remove_dir_all(&d);
 }

@@ -7,28 +7,36 @@
 //! | 0 | 4 | magic `b"YAWC"` |
 //! | 4 | 2 | format version ([`FORMAT_VERSION`]) |
 //! | 6 | 2 | payload length `L` (at most [`MAX_PAYLOAD_LEN`]) |
-//! | 8 | `L` | postcard encoding of [`ModelSpec`] |
+//! | 8 | `L` | postcard encoding of [`ModelSpec`] (version 3: followed by its [`TrackSpec`]) |
 //! | 8 + `L` | 4 | CRC-32 (IEEE) of the payload |
 //!
 //! [`decode_blob`] checks every part and validates the model (finite, sane, stable), so a
 //! blob that decodes is safe to hand to the firmware predictor.
 //!
-//! Version 2 carries the model in the difference form of [`crate::model`]; version 1 carried
+//! Version 2 carries the model in the difference form of [`crate::model`]; version 3 carries
+//! the same model followed by its heading/track part ([`crate::nav`]). A model without a
+//! track part is still written as version 2, byte for byte as before, so a controller
+//! older than the track part keeps loading it; both versions are read. Version 1 carried
 //! the shift-form companion row, which `f32` cannot hold for poles close to 1, and is refused
 //! ([`BlobError::UnsupportedVersion`]): export the model again.
 
 use crate::crc::crc32;
 use crate::model::{ModelError, ModelSpec};
+use crate::nav::{TrackError, TrackSpec};
 
 /// First four bytes of every blob.
 pub const MAGIC: [u8; 4] = *b"YAWC";
-/// The blob format version this crate writes and reads.
-pub const FORMAT_VERSION: u16 = 2;
+/// The newest blob format version (a model with its track part); this crate reads it and
+/// [`MODEL_ONLY_VERSION`].
+pub const FORMAT_VERSION: u16 = 3;
+/// The version of a blob without a track part (written for such models, read as ever).
+pub const MODEL_ONLY_VERSION: u16 = 2;
 /// Bytes before the payload: magic, version, payload length.
 pub const HEADER_LEN: usize = 8;
 /// Bytes after the payload: the CRC.
 pub const TRAILER_LEN: usize = 4;
-/// Largest payload accepted. The largest valid model (order 8, all ten effects) needs 171.
+/// Largest payload accepted. The largest valid model (order 8, all ten effects) needs 171,
+/// 212 with a track part.
 pub const MAX_PAYLOAD_LEN: usize = 256;
 /// Largest blob: header, payload, CRC.
 pub const MAX_BLOB_LEN: usize = HEADER_LEN + MAX_PAYLOAD_LEN + TRAILER_LEN;
@@ -51,7 +59,7 @@ pub enum BlobError {
     },
     /// The first four bytes are not [`MAGIC`].
     BadMagic,
-    /// The format version is not [`FORMAT_VERSION`].
+    /// The format version is neither [`MODEL_ONLY_VERSION`] nor [`FORMAT_VERSION`].
     UnsupportedVersion(u16),
     /// The stored CRC does not match the payload.
     BadCrc {
@@ -66,6 +74,8 @@ pub enum BlobError {
     InvalidModel(ModelError),
     /// The output buffer given to [`encode_blob`] is too small.
     BufferTooSmall,
+    /// The track part of a version 3 blob is not valid.
+    InvalidTrack(TrackError),
 }
 
 impl core::fmt::Display for BlobError {
@@ -81,7 +91,7 @@ impl core::fmt::Display for BlobError {
             BlobError::BadMagic => write!(f, "not a yawcast model blob (bad magic)"),
             BlobError::UnsupportedVersion(v) => write!(
                 f,
-                "model blob format version {v} is not supported (expected {FORMAT_VERSION})"
+                "model blob format version {v} is not supported (expected {MODEL_ONLY_VERSION} or {FORMAT_VERSION})"
             ),
             BlobError::BadCrc { stored, computed } => write!(
                 f,
@@ -90,6 +100,7 @@ impl core::fmt::Display for BlobError {
             BlobError::BadPayload => write!(f, "model blob payload is not a model"),
             BlobError::InvalidModel(e) => write!(f, "model blob holds an invalid model: {e}"),
             BlobError::BufferTooSmall => write!(f, "buffer too small for the model blob"),
+            BlobError::InvalidTrack(e) => write!(f, "model blob holds an invalid {e}"),
         }
     }
 }
@@ -120,17 +131,63 @@ impl From<ModelError> for BlobError {
 /// assert_eq!(decode_blob(blob), Ok(m));
 /// ```
 pub fn encode_blob<'a>(spec: &ModelSpec, buf: &'a mut [u8]) -> Result<&'a [u8], BlobError> {
+    encode_blob_with_track(spec, None, buf)
+}
+
+/// Writes `spec` and, when given, its track part as a blob into `buf` and returns the bytes
+/// written: version [`FORMAT_VERSION`] with a track part, [`MODEL_ONLY_VERSION`] without.
+///
+/// # Errors
+/// As [`encode_blob`], and [`BlobError::InvalidTrack`] when the track part does not validate
+/// for the model's sample time.
+///
+/// ```
+/// use yawcast_shared::blob::{decode_blob_with_track, encode_blob_with_track, MAX_BLOB_LEN};
+/// use yawcast_shared::model::{ModelSpec, Units};
+/// use yawcast_shared::nav::TrackSpec;
+/// let m = ModelSpec::new(2, 1.0, &[-0.7, -1.5], &[0.1, -0.05], &[0.3, -0.2],
+///                        Units::default(), &[]).unwrap();
+/// let t = TrackSpec::new(1.0, 1.3, true).unwrap();
+/// let mut buf = [0u8; MAX_BLOB_LEN];
+/// let blob = encode_blob_with_track(&m, Some(&t), &mut buf).unwrap();
+/// assert_eq!(&blob[4..6], &[3, 0]);
+/// assert_eq!(blob.len(), 8 + 35 + 41 + 4);
+/// assert_eq!(decode_blob_with_track(blob), Ok((m, Some(t))));
+/// ```
+pub fn encode_blob_with_track<'a>(
+    spec: &ModelSpec,
+    track: Option<&TrackSpec>,
+    buf: &'a mut [u8],
+) -> Result<&'a [u8], BlobError> {
     spec.validate()?;
+    if let Some(t) = track {
+        t.validate(spec.ts).map_err(BlobError::InvalidTrack)?;
+    }
     if buf.len() < HEADER_LEN + TRAILER_LEN {
         return Err(BlobError::BufferTooSmall);
     }
     let room = (buf.len() - HEADER_LEN - TRAILER_LEN).min(MAX_PAYLOAD_LEN);
-    let payload_len = postcard::to_slice(spec, &mut buf[HEADER_LEN..HEADER_LEN + room])
+    let area = &mut buf[HEADER_LEN..HEADER_LEN + room];
+    let model_len = postcard::to_slice(spec, area)
         .map_err(|_| BlobError::BufferTooSmall)?
         .len();
+    let payload_len = match track {
+        Some(t) => {
+            model_len
+                + postcard::to_slice(t, &mut area[model_len..])
+                    .map_err(|_| BlobError::BufferTooSmall)?
+                    .len()
+        }
+        None => model_len,
+    };
+    let version = if track.is_some() {
+        FORMAT_VERSION
+    } else {
+        MODEL_ONLY_VERSION
+    };
     let crc = crc32(&buf[HEADER_LEN..HEADER_LEN + payload_len]);
     buf[0..4].copy_from_slice(&MAGIC);
-    buf[4..6].copy_from_slice(&FORMAT_VERSION.to_le_bytes());
+    buf[4..6].copy_from_slice(&version.to_le_bytes());
     // payload_len ≤ MAX_PAYLOAD_LEN < 2^16
     buf[6..8].copy_from_slice(&(payload_len as u16).to_le_bytes());
     let end = HEADER_LEN + payload_len;
@@ -159,6 +216,27 @@ pub fn encode_blob<'a>(spec: &ModelSpec, buf: &'a mut [u8]) -> Result<&'a [u8], 
 /// assert_eq!(decode_blob(b"PNG\x89...."), Err(BlobError::BadMagic));
 /// ```
 pub fn decode_blob(bytes: &[u8]) -> Result<ModelSpec, BlobError> {
+    decode_blob_with_track(bytes).map(|(spec, _)| spec)
+}
+
+/// Reads and validates a blob of either version with its track part (`None` in a version 2
+/// blob); the checks of [`decode_blob`], then the track part's own for the model's sample
+/// time.
+///
+/// # Errors
+/// As [`decode_blob`], and [`BlobError::InvalidTrack`].
+///
+/// ```
+/// use yawcast_shared::blob::{decode_blob_with_track, encode_blob, MAX_BLOB_LEN};
+/// use yawcast_shared::model::{ModelSpec, Units};
+/// let m = ModelSpec::new(2, 1.0, &[-0.7, -1.5], &[0.1, -0.05], &[0.3, -0.2],
+///                        Units::default(), &[]).unwrap();
+/// let mut buf = [0u8; MAX_BLOB_LEN];
+/// let blob = encode_blob(&m, &mut buf).unwrap(); // no track part: version 2
+/// assert_eq!(&blob[4..6], &[2, 0]);
+/// assert_eq!(decode_blob_with_track(blob), Ok((m, None)));
+/// ```
+pub fn decode_blob_with_track(bytes: &[u8]) -> Result<(ModelSpec, Option<TrackSpec>), BlobError> {
     if bytes.len() < HEADER_LEN {
         return Err(BlobError::Truncated {
             len: bytes.len(),
@@ -169,7 +247,7 @@ pub fn decode_blob(bytes: &[u8]) -> Result<ModelSpec, BlobError> {
         return Err(BlobError::BadMagic);
     }
     let version = u16::from_le_bytes([bytes[4], bytes[5]]);
-    if version != FORMAT_VERSION {
+    if version != FORMAT_VERSION && version != MODEL_ONLY_VERSION {
         return Err(BlobError::UnsupportedVersion(version));
     }
     let payload_len = usize::from(u16::from_le_bytes([bytes[6], bytes[7]]));
@@ -195,11 +273,21 @@ pub fn decode_blob(bytes: &[u8]) -> Result<ModelSpec, BlobError> {
     }
     let (spec, rest): (ModelSpec, &[u8]) =
         postcard::take_from_bytes(payload).map_err(|_| BlobError::BadPayload)?;
+    let (track, rest) = if version == FORMAT_VERSION {
+        let (t, rest): (TrackSpec, &[u8]) =
+            postcard::take_from_bytes(rest).map_err(|_| BlobError::BadPayload)?;
+        (Some(t), rest)
+    } else {
+        (None, rest)
+    };
     if !rest.is_empty() {
         return Err(BlobError::BadPayload);
     }
     spec.validate()?;
-    Ok(spec)
+    if let Some(t) = &track {
+        t.validate(spec.ts).map_err(BlobError::InvalidTrack)?;
+    }
+    Ok((spec, track))
 }
 
 #[cfg(test)]
@@ -287,7 +375,7 @@ mod tests {
         let plen = p.len();
         let mut b = [0u8; MAX_BLOB_LEN];
         b[..4].copy_from_slice(&MAGIC);
-        b[4..6].copy_from_slice(&FORMAT_VERSION.to_le_bytes());
+        b[4..6].copy_from_slice(&MODEL_ONLY_VERSION.to_le_bytes());
         b[6..8].copy_from_slice(&(plen as u16).to_le_bytes());
         b[8..8 + plen].copy_from_slice(&pb[..plen]);
         let crc = crc32(&pb[..plen]);

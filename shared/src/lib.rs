@@ -12,6 +12,7 @@ pub mod blob;
 pub mod crc;
 pub mod kernel;
 pub mod model;
+pub mod nav;
 pub mod wire;
 
 #[cfg(test)]

@@ -3,11 +3,15 @@
 
 use std::vec::Vec as StdVec;
 
-use crate::blob::{decode_blob, encode_blob, BlobError, MAX_BLOB_LEN};
+use crate::blob::{
+    decode_blob, decode_blob_with_track, encode_blob, encode_blob_with_track, BlobError,
+    MAX_BLOB_LEN,
+};
 use crate::crc::crc32;
 use crate::model::{Effect, ModelSpec, Units};
+use crate::nav::{TrackError, TrackField, TrackSpec};
 use crate::wire::{
-    AckStatus, DeviceMessage, ErrorCode, Feed, FrameAccumulator, HostMessage, WireError,
+    AckStatus, DeviceMessage, ErrorCode, Feed, FrameAccumulator, HostMessage, NavStatus, WireError,
     MAX_FRAME_LEN,
 };
 
@@ -53,6 +57,86 @@ fn reference_blob_bytes() {
     assert_eq!(decode_blob(&REFERENCE_BLOB), Ok(reference_model()));
 }
 
+/// The reference model's track part (values exact in binary).
+fn reference_track() -> TrackSpec {
+    let mut t = TrackSpec::new(0.5, 1.25, true).unwrap();
+    t.sway = -0.0625;
+    t.speed_loss = 0.007_812_5;
+    t
+}
+
+/// The reference model with its track part: a version 3 blob, byte for byte.
+const REFERENCE_TRACK_BLOB: [u8; 114] = [
+    0x59, 0x41, 0x57, 0x43, // "YAWC"
+    0x03, 0x00, // version 3
+    0x66, 0x00, // payload length 102: the model's 61 bytes, then the track part's 41
+    0x04, 0x00, 0x00, 0x00, 0x3f, 0x04, 0x9a, 0x99, 0x19, 0xbf, 0x66, 0x66, 0x26, 0xc0, 0x00, 0x00,
+    0x90, 0xc0, 0x9a, 0x99, 0x59, 0xc0, 0x04, 0x0a, 0xd7, 0x23, 0x3c, 0x0a, 0xd7, 0x23, 0x3c, 0x0a,
+    0xd7, 0xa3, 0x3b, 0x6f, 0x12, 0x03, 0x3b, 0x04, 0xcd, 0xcc, 0xcc, 0x3d, 0x0a, 0xd7, 0x23, 0x3c,
+    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x01, 0x02,
+    0x02, // the model, as in REFERENCE_BLOB
+    0x00, 0x00, 0xa0, 0x3f, // speed 1.25
+    0x00, 0x00, 0x80, 0xbd, // sway −0.0625
+    0x00, 0x00, 0x00, 0x3c, // speed loss 0.0078125
+    0x01, // current estimated
+    0xcd, 0xcc, 0x4c, 0x3d, // gain_speed 0.05
+    0x6f, 0x12, 0x03, 0x3b, // gain_current 0.002
+    0x00, 0x00, 0x00, 0x3f, // gain_position 0.5
+    0x0a, 0xd7, 0xa3, 0x3c, // fix_speed 0.01/0.5
+    0x6f, 0x12, 0x83, 0x3b, // fix_current 0.002/0.5
+    0x00, 0x00, 0x40, 0x40, // gate_velocity 3
+    0x00, 0x00, 0x48, 0x43, // gate_position 200
+    0xd2, 0x3a, 0x71, 0xea, // CRC-32
+];
+
+#[test]
+fn reference_track_blob_bytes() {
+    let mut buf = [0u8; MAX_BLOB_LEN];
+    let blob =
+        encode_blob_with_track(&reference_model(), Some(&reference_track()), &mut buf).unwrap();
+    assert_eq!(blob, &REFERENCE_TRACK_BLOB[..]);
+    assert_eq!(
+        decode_blob_with_track(&REFERENCE_TRACK_BLOB),
+        Ok((reference_model(), Some(reference_track())))
+    );
+    // the model alone from a version 3 blob, and a version 2 blob without a track part
+    assert_eq!(decode_blob(&REFERENCE_TRACK_BLOB), Ok(reference_model()));
+    assert_eq!(
+        decode_blob_with_track(&REFERENCE_BLOB),
+        Ok((reference_model(), None))
+    );
+    // a bad track part is refused on encode, and on decode with a correct CRC
+    let mut bad = reference_track();
+    bad.gate_velocity = -1.0;
+    assert_eq!(
+        encode_blob_with_track(&reference_model(), Some(&bad), &mut buf),
+        Err(BlobError::InvalidTrack(TrackError::OutOfRange(
+            TrackField::GateVelocity
+        )))
+    );
+    let mut b = REFERENCE_TRACK_BLOB;
+    b[102..106].copy_from_slice(&(-1.0f32).to_le_bytes());
+    let crc = crc32(&b[8..110]);
+    b[110..114].copy_from_slice(&crc.to_le_bytes());
+    assert_eq!(
+        decode_blob_with_track(&b),
+        Err(BlobError::InvalidTrack(TrackError::OutOfRange(
+            TrackField::GateVelocity
+        )))
+    );
+    // a version 3 blob cut after the model: not a model with its track part
+    let mut b = [0u8; 73];
+    b.copy_from_slice(&REFERENCE_BLOB);
+    b[4] = 3;
+    assert_eq!(decode_blob(&b), Err(BlobError::BadPayload));
+    // an unknown version names both readable ones
+    b[4] = 4;
+    assert_eq!(
+        std::string::ToString::to_string(&decode_blob(&b).unwrap_err()),
+        "model blob format version 4 is not supported (expected 2 or 3)"
+    );
+}
+
 fn host_golden() -> StdVec<(HostMessage<'static>, &'static [u8])> {
     std::vec![
         (HostMessage::Ping, &[0x01, 0x01, 0x00][..]),
@@ -88,6 +172,39 @@ fn host_golden() -> StdVec<(HostMessage<'static>, &'static [u8])> {
         ),
         (HostMessage::Reset, &[0x02, 0x04, 0x00]),
         (HostMessage::Shutdown { code: 7 }, &[0x03, 0x05, 0x07, 0x00]),
+        (
+            HostMessage::TrackMeasurement {
+                u: 1.5,
+                y: -0.25,
+                psi: Some(90.0),
+                velocity: Some([1.0, -0.5]),
+                fix: None,
+            },
+            &[
+                0x02, 0x06, 0x01, 0x03, 0xc0, 0x3f, 0x01, 0x04, 0x80, 0xbe, 0x01, 0x01, 0x04, 0xb4,
+                0x42, 0x01, 0x01, 0x03, 0x80, 0x3f, 0x01, 0x01, 0x02, 0xbf, 0x01, 0x00,
+            ],
+        ),
+        (
+            HostMessage::TrackMeasurement {
+                u: 0.0,
+                y: 0.0,
+                psi: None,
+                velocity: None,
+                fix: Some([2.0, 4.0]),
+            },
+            &[
+                0x02, 0x06, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x01, 0x02, 0x01, 0x01,
+                0x01, 0x02, 0x40, 0x01, 0x03, 0x80, 0x40, 0x00,
+            ],
+        ),
+        (
+            HostMessage::TrackPredictRequest {
+                horizon: 2,
+                future_u: heapless::Vec::from_slice(&[1.0]).unwrap(),
+            },
+            &[0x04, 0x07, 0x02, 0x01, 0x01, 0x03, 0x80, 0x3f, 0x00],
+        ),
     ]
 }
 
@@ -130,6 +247,38 @@ fn device_golden() -> StdVec<(DeviceMessage, &'static [u8])> {
                 code: ErrorCode::BlobBadCrc,
             },
             &[0x03, 0x05, 0x08, 0x00],
+        ),
+        (
+            DeviceMessage::TrackAck {
+                sample: 2,
+                status: AckStatus::Corrected,
+                velocity: NavStatus::Applied,
+                fix: NavStatus::Gated,
+                reset: false,
+            },
+            &[0x03, 0x06, 0x02, 0x03, 0x01, 0x03, 0x01, 0x00],
+        ),
+        (
+            DeviceMessage::TrackPrediction {
+                sample: 1,
+                values: heapless::Vec::from_slice(&[90.0, 1.0, -0.5]).unwrap(),
+            },
+            &[
+                0x04, 0x07, 0x01, 0x03, 0x01, 0x03, 0xb4, 0x42, 0x01, 0x03, 0x80, 0x3f, 0x01, 0x01,
+                0x02, 0xbf, 0x00,
+            ],
+        ),
+        (
+            DeviceMessage::Error {
+                code: ErrorCode::TrackInvalid,
+            },
+            &[0x03, 0x05, 0x10, 0x00],
+        ),
+        (
+            DeviceMessage::Error {
+                code: ErrorCode::NoTrack,
+            },
+            &[0x03, 0x05, 0x11, 0x00],
         ),
     ]
 }

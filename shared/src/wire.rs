@@ -12,8 +12,10 @@
 //! Conversation: the device sends [`DeviceMessage::Banner`] when its UART is up. Each host
 //! message gets exactly one answer: `Ping` → `Pong`; `LoadModel` → `ModelLoaded`;
 //! `Measurement` → `Ack`; `PredictRequest` → `Prediction`; `Reset` → `Ack` with
-//! [`AckStatus::Cleared`]; any failure → `Error` with an [`ErrorCode`]. `Shutdown` is for
-//! tests under an emulator and is not answered.
+//! [`AckStatus::Cleared`]; `TrackMeasurement` → `TrackAck`; `TrackPredictRequest` →
+//! `TrackPrediction`; any failure → `Error` with an [`ErrorCode`]. `Shutdown` is for tests
+//! under an emulator and is not answered. The track messages (protocol 2) were appended, so
+//! every message of protocol 1 keeps its bytes.
 
 use heapless::Vec;
 use serde::{Deserialize, Serialize};
@@ -22,7 +24,7 @@ use crate::blob::BlobError;
 use crate::model::ModelError;
 
 /// Version of this message set, sent in the banner.
-pub const PROTOCOL_VERSION: u16 = 1;
+pub const PROTOCOL_VERSION: u16 = 2;
 /// Largest prediction horizon H (steps ahead) a `PredictRequest` may ask for.
 pub const MAX_HORIZON: usize = 64;
 /// Largest postcard message (before COBS): a `LoadModel` with a [`MAX_BLOB_LEN`](crate::blob::MAX_BLOB_LEN) blob needs
@@ -37,6 +39,8 @@ pub const MAX_FRAME_LEN: usize = MAX_ENCODED_LEN + 1;
 pub type Values = Vec<f32, MAX_HORIZON>;
 /// Future commands of a [`HostMessage::PredictRequest`] (at most `MAX_HORIZON − 1`).
 pub type FutureInputs = Vec<f32, { MAX_HORIZON - 1 }>;
+/// Largest horizon of a [`HostMessage::TrackPredictRequest`]: its 3·H values fit [`Values`].
+pub const MAX_TRACK_HORIZON: usize = MAX_HORIZON / 3;
 
 /// Host → device.
 // Messages live on the stack of a no-alloc device: variants are inline by design.
@@ -70,6 +74,28 @@ pub enum HostMessage<'a> {
     Shutdown {
         /// Process exit code.
         code: u8,
+    },
+    /// A `Measurement` with the navigation channels: runs the yaw-rate update, then the
+    /// heading/track update (the model must have a track part).
+    TrackMeasurement {
+        /// Commanded angle u(t).
+        u: f32,
+        /// Measured yaw rate y(t); non-finite means missing.
+        y: f32,
+        /// Measured heading ψ(t) in degrees, if any.
+        psi: Option<f32>,
+        /// Ground velocity (north, east) in m/s, if measured.
+        velocity: Option<[f32; 2]>,
+        /// Position fix (north, east) in metres, if measured.
+        fix: Option<[f32; 2]>,
+    },
+    /// Ask for the heading and position at t+1 … t+H (H ≤ [`MAX_TRACK_HORIZON`]), from the
+    /// yaw-rate prediction with these future commands.
+    TrackPredictRequest {
+        /// H, `1..=MAX_TRACK_HORIZON`.
+        horizon: u8,
+        /// Future commands u(t+1), u(t+2), ….
+        future_u: FutureInputs,
     },
 }
 
@@ -118,6 +144,40 @@ pub enum DeviceMessage {
         /// What went wrong.
         code: ErrorCode,
     },
+    /// Answer to `TrackMeasurement`.
+    TrackAck {
+        /// Number of measurements processed since the model was loaded or reset.
+        sample: u32,
+        /// What the yaw-rate update did.
+        status: AckStatus,
+        /// What became of the ground velocity.
+        velocity: NavStatus,
+        /// What became of the position fix.
+        fix: NavStatus,
+        /// The track state went non-finite and was reset.
+        reset: bool,
+    },
+    /// Answer to `TrackPredictRequest`: `ψ̂ (deg), n (m), e (m)` at t+1, then at t+2, …
+    /// (3·H values).
+    TrackPrediction {
+        /// Number of measurements the prediction is based on.
+        sample: u32,
+        /// The 3·H values, row after row.
+        values: Values,
+    },
+}
+
+/// What became of one navigation measurement, as reported in [`DeviceMessage::TrackAck`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum NavStatus {
+    /// Not measured.
+    Absent,
+    /// Applied.
+    Applied,
+    /// Not finite: skipped.
+    Rejected,
+    /// Innovation beyond its gate (a jump): skipped.
+    Gated,
 }
 
 /// Outcome of a measurement update, as reported in [`DeviceMessage::Ack`].
@@ -171,6 +231,10 @@ pub enum ErrorCode {
     NotEnoughInputs = 14,
     /// The prediction went non-finite.
     NonFinite = 15,
+    /// The blob's track part is not valid.
+    TrackInvalid = 16,
+    /// A track request, but the loaded model has no track part.
+    NoTrack = 17,
 }
 
 impl ErrorCode {
@@ -198,6 +262,7 @@ impl From<BlobError> for ErrorCode {
             BlobError::BadCrc { .. } => ErrorCode::BlobBadCrc,
             BlobError::BadPayload => ErrorCode::BlobBadPayload,
             BlobError::InvalidModel(m) => m.into(),
+            BlobError::InvalidTrack(_) => ErrorCode::TrackInvalid,
         }
     }
 }

@@ -9,6 +9,7 @@
 
 pub mod data;
 pub mod qemu;
+pub mod track;
 
 use yawcast_firmware::{Predictor, UpdateStatus};
 use yawcast_shared::model::{Effect, ModelSpec, Units};

@@ -138,7 +138,7 @@ fn qemu_predictions_equal_native_and_goldens_bit_for_bit() {
     assert_eq!(
         banner,
         DeviceMessage::Banner {
-            protocol: 1,
+            protocol: yawcast_shared::wire::PROTOCOL_VERSION,
             blob_version: yawcast_shared::blob::FORMAT_VERSION,
             order: 4,
             model_loaded: false
@@ -367,7 +367,7 @@ fn raw_blob(m: &ModelSpec) -> Vec<u8> {
     let p = postcard_bytes(m, &mut payload);
     let mut out = Vec::new();
     out.extend_from_slice(b"YAWC");
-    out.extend_from_slice(&yawcast_shared::blob::FORMAT_VERSION.to_le_bytes());
+    out.extend_from_slice(&yawcast_shared::blob::MODEL_ONLY_VERSION.to_le_bytes());
     out.extend_from_slice(&(p.len() as u16).to_le_bytes());
     out.extend_from_slice(p);
     out.extend_from_slice(&yawcast_shared::crc::crc32(p).to_le_bytes());

@@ -4,7 +4,10 @@
 //! 115 200 baud from the 16 MHz internal oscillator), logs with defmt over semihosting.
 //! At boot it sends a `Banner`, loads the model linked into flash if one was built in
 //! (`YAWCAST_BUILTIN_MODEL`), then serves requests forever: `LoadModel`, `Measurement`,
-//! `PredictRequest`, `Reset`, `Ping`; every failure is answered with an `Error` frame.
+//! `PredictRequest`, `TrackMeasurement`, `TrackPredictRequest`, `Reset`, `Ping`; every
+//! failure is answered with an `Error` frame. A model with a track part (blob version 3)
+//! also runs the heading/track predictor: every measurement updates it (a plain
+//! `Measurement` without navigation channels).
 //! This build runs models of order 4.
 #![cfg_attr(target_os = "none", no_std)]
 #![cfg_attr(target_os = "none", no_main)]
@@ -14,11 +17,12 @@ mod app {
     use cortex_m as _; // critical-section implementation (single core)
     use cortex_m_rt::entry;
     use defmt_semihosting as _;
+    use yawcast_firmware::track::{Correction, NavMeasurement, Tracker};
     use yawcast_firmware::{Predictor, PredictorError, UpdateStatus, MAX_HORIZON};
     use yawcast_shared::blob::{self, FORMAT_VERSION};
     use yawcast_shared::wire::{
-        AckStatus, DeviceMessage, ErrorCode, Feed, FrameAccumulator, HostMessage, Values,
-        MAX_FRAME_LEN, PROTOCOL_VERSION,
+        AckStatus, DeviceMessage, ErrorCode, Feed, FrameAccumulator, HostMessage, NavStatus,
+        Values, MAX_FRAME_LEN, MAX_TRACK_HORIZON, PROTOCOL_VERSION,
     };
 
     /// Model order this build runs.
@@ -93,10 +97,29 @@ mod app {
         }
     }
 
-    /// The app's state: the predictor (once a model is loaded) and the sample counter.
+    /// The app's state: the predictor (once a model is loaded), the heading/track predictor
+    /// (when the model has a track part) and the sample counter.
     struct App {
         predictor: Option<Predictor<ORDER>>,
+        tracker: Option<Tracker>,
         sample: u32,
+    }
+
+    fn nav_status(c: Correction) -> NavStatus {
+        match c {
+            Correction::Absent => NavStatus::Absent,
+            Correction::Applied => NavStatus::Applied,
+            Correction::Rejected => NavStatus::Rejected,
+            Correction::Gated => NavStatus::Gated,
+        }
+    }
+
+    fn predictor_error(e: PredictorError) -> ErrorCode {
+        match e {
+            PredictorError::HorizonOutOfRange(_) => ErrorCode::HorizonOutOfRange,
+            PredictorError::NotEnoughInputs { .. } => ErrorCode::NotEnoughInputs,
+            _ => ErrorCode::NonFinite,
+        }
     }
 
     impl App {
@@ -104,8 +127,8 @@ mod app {
         // blob decoding and model validation would be laid down twice (≈ 5 KiB of flash).
         #[inline(never)]
         fn load(&mut self, bytes: &[u8]) -> DeviceMessage {
-            let spec = match blob::decode_blob(bytes) {
-                Ok(spec) => spec,
+            let (spec, track) = match blob::decode_blob_with_track(bytes) {
+                Ok(decoded) => decoded,
                 Err(e) => {
                     defmt::warn!(
                         "model blob refused: error code {=u8}",
@@ -114,9 +137,19 @@ mod app {
                     return DeviceMessage::Error { code: e.into() };
                 }
             };
+            let tracker = match track.map(|t| Tracker::new(&spec, &t)) {
+                None => None,
+                Some(Ok(t)) => Some(t),
+                Some(Err(_)) => {
+                    return DeviceMessage::Error {
+                        code: ErrorCode::TrackInvalid,
+                    }
+                }
+            };
             match Predictor::<ORDER>::new(&spec) {
                 Ok(p) => {
                     self.predictor = Some(p);
+                    self.tracker = tracker;
                     self.sample = 0;
                     // a decoded blob ends with its 4-byte CRC
                     let crc = match bytes.len().checked_sub(4).and_then(|i| bytes.get(i..)) {
@@ -151,6 +184,57 @@ mod app {
             }
         }
 
+        /// One measurement: the yaw-rate update, then (with a track part) the heading/track
+        /// update with the rate the predictor used; `nav` is `Some` for a `TrackMeasurement`
+        /// (answered with `TrackAck`, refused before any state moves when the model has no
+        /// track part), `None` for a `Measurement` (answered with `Ack`).
+        fn measured(
+            &mut self,
+            u: f32,
+            y: f32,
+            psi: Option<f32>,
+            nav: Option<NavMeasurement>,
+        ) -> DeviceMessage {
+            let Some(p) = self.predictor.as_mut() else {
+                return DeviceMessage::Error {
+                    code: ErrorCode::NoModel,
+                };
+            };
+            if nav.is_some() && self.tracker.is_none() {
+                return DeviceMessage::Error {
+                    code: ErrorCode::NoTrack,
+                };
+            }
+            let before = p.prediction();
+            let status = match p.update_with_heading(u, y, psi) {
+                UpdateStatus::Corrected => AckStatus::Corrected,
+                UpdateStatus::SkippedCorrection => AckStatus::SkippedCorrection,
+                _ => {
+                    defmt::warn!("state went non-finite; reset");
+                    AckStatus::NonFiniteReset
+                }
+            };
+            let rate = if y.is_finite() { y } else { before };
+            let track = self
+                .tracker
+                .as_mut()
+                .map(|t| t.update(rate, psi, &nav.unwrap_or_default()));
+            self.sample = self.sample.wrapping_add(1);
+            match (nav, track) {
+                (Some(_), Some(t)) => DeviceMessage::TrackAck {
+                    sample: self.sample,
+                    status,
+                    velocity: nav_status(t.velocity),
+                    fix: nav_status(t.fix),
+                    reset: t.reset,
+                },
+                _ => DeviceMessage::Ack {
+                    sample: self.sample,
+                    status,
+                },
+            }
+        }
+
         fn handle(&mut self, frame: &[u8]) -> Option<DeviceMessage> {
             let msg = match HostMessage::decode(frame) {
                 Ok(m) => m,
@@ -162,26 +246,48 @@ mod app {
             let reply = match msg {
                 HostMessage::Ping => DeviceMessage::Pong,
                 HostMessage::LoadModel(bytes) => self.load(bytes),
-                HostMessage::Measurement { u, y, psi } => match self.predictor.as_mut() {
-                    None => DeviceMessage::Error {
-                        code: ErrorCode::NoModel,
-                    },
-                    Some(p) => {
-                        let status = match p.update_with_heading(u, y, psi) {
-                            UpdateStatus::Corrected => AckStatus::Corrected,
-                            UpdateStatus::SkippedCorrection => AckStatus::SkippedCorrection,
-                            _ => {
-                                defmt::warn!("state went non-finite; reset");
-                                AckStatus::NonFiniteReset
+                HostMessage::Measurement { u, y, psi } => self.measured(u, y, psi, None),
+                HostMessage::TrackMeasurement {
+                    u,
+                    y,
+                    psi,
+                    velocity,
+                    fix,
+                } => self.measured(u, y, psi, Some(NavMeasurement { velocity, fix })),
+                HostMessage::TrackPredictRequest { horizon, future_u } => {
+                    match (self.predictor.as_ref(), self.tracker.as_ref()) {
+                        (None, _) => DeviceMessage::Error {
+                            code: ErrorCode::NoModel,
+                        },
+                        (Some(_), None) => DeviceMessage::Error {
+                            code: ErrorCode::NoTrack,
+                        },
+                        (Some(p), Some(t)) => {
+                            let h = usize::from(horizon);
+                            let mut rates = [0.0f32; MAX_TRACK_HORIZON];
+                            let mut rows = [[0.0f32; 3]; MAX_TRACK_HORIZON];
+                            let result = match (rates.get_mut(..h), rows.get_mut(..h)) {
+                                (Some(r), Some(o)) if h > 0 => p
+                                    .predict_into(r, &future_u)
+                                    .and_then(|()| t.predict_into(o, r)),
+                                _ => Err(PredictorError::HorizonOutOfRange(h)),
+                            };
+                            match result {
+                                Ok(()) => DeviceMessage::TrackPrediction {
+                                    sample: self.sample,
+                                    values: rows
+                                        .as_flattened()
+                                        .get(..3 * h)
+                                        .and_then(|v| Values::from_slice(v).ok())
+                                        .unwrap_or_default(),
+                                },
+                                Err(e) => DeviceMessage::Error {
+                                    code: predictor_error(e),
+                                },
                             }
-                        };
-                        self.sample = self.sample.wrapping_add(1);
-                        DeviceMessage::Ack {
-                            sample: self.sample,
-                            status,
                         }
                     }
-                },
+                }
                 HostMessage::PredictRequest { horizon, future_u } => {
                     match self.predictor.as_ref() {
                         None => DeviceMessage::Error {
@@ -200,15 +306,7 @@ mod app {
                                     values: Values::from_slice(&out[..h]).unwrap_or_default(),
                                 },
                                 Err(e) => DeviceMessage::Error {
-                                    code: match e {
-                                        PredictorError::HorizonOutOfRange(_) => {
-                                            ErrorCode::HorizonOutOfRange
-                                        }
-                                        PredictorError::NotEnoughInputs { .. } => {
-                                            ErrorCode::NotEnoughInputs
-                                        }
-                                        _ => ErrorCode::NonFinite,
-                                    },
+                                    code: predictor_error(e),
                                 },
                             }
                         }
@@ -217,6 +315,9 @@ mod app {
                 HostMessage::Reset => {
                     if let Some(p) = self.predictor.as_mut() {
                         p.reset();
+                    }
+                    if let Some(t) = self.tracker.as_mut() {
+                        t.reset();
                     }
                     self.sample = 0;
                     DeviceMessage::Ack {
@@ -246,6 +347,7 @@ mod app {
         defmt::info!("yawcast-fw {=str} up", env!("CARGO_PKG_VERSION"));
         let mut app = App {
             predictor: None,
+            tracker: None,
             sample: 0,
         };
         let mut tx = [0u8; MAX_FRAME_LEN];

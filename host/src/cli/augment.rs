@@ -14,7 +14,12 @@ use yawcast::io::export;
 use yawcast::sim::{Ship, SimEffect};
 use yawcast_shared::model::EffectKind;
 
-use super::common::{bad, check_record_for_model, read_model, JsonArg, Outputs, ReadArgs, SeedArg};
+use super::common::{
+    bad, check_record_for_model, read_model, read_track, JsonArg, Outputs, ReadArgs, SeedArg,
+};
+use std::collections::BTreeMap;
+use yawcast::identify::track::evaluate;
+use yawcast_shared::nav::TrackSpec;
 
 /// Arguments of `yawcast augment`.
 #[derive(Debug, Args)]
@@ -114,6 +119,106 @@ pub struct AugmentSummary {
     pub more: Option<MoreSummary>,
     /// The effects of the model written, in the order they act.
     pub effects: Vec<String>,
+    /// `--effect current` on a model with a heading/track part and held-out records with
+    /// navigation channels: the track error before and after the track's current estimate.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub track_error_m: Option<TrackBeforeAfter>,
+}
+
+/// The track error (m) of `augment --effect current`, before and after.
+#[derive(Debug, Serialize)]
+pub struct TrackBeforeAfter {
+    /// Mean over the held-out records of the median track error, keyed by horizon in
+    /// seconds ("30", "60", "120"), with the model's track part as given.
+    pub before: BTreeMap<String, f64>,
+    /// The same with the current estimated.
+    pub after: BTreeMap<String, f64>,
+    /// Whether the current part was kept (it lowers the 60-s error) and written.
+    pub kept: bool,
+    /// Records scored.
+    pub records: usize,
+}
+
+/// The track errors of `augment --effect current` on the held-out records (`val`, else
+/// `est`), and the track part to write; `None` (with a note) when the model has no track
+/// part or the records no navigation channels.
+fn track_current(
+    args: &AugmentArgs,
+    given: &Model,
+    written: &Model,
+    paths_recs: (&[PathBuf], &[Record]),
+) -> Result<Option<(TrackBeforeAfter, TrackSpec)>> {
+    let Some(before_t) = read_track(&args.model, given)? else {
+        eprintln!(
+            "note: {}: the model has no heading/track part: the track error is not scored",
+            args.model.display()
+        );
+        return Ok(None);
+    };
+    let (paths, recs) = paths_recs;
+    let mut after_t = before_t;
+    after_t.current = true;
+    let defaults = TrackSpec::new(written.ts as f32, before_t.speed, true).map_err(bad)?;
+    after_t.gain_current = defaults.gain_current;
+    after_t.fix_current = defaults.fix_current;
+    const SECS: [f64; 3] = [30.0, 60.0, 120.0];
+    let mut sums: [BTreeMap<String, (f64, usize)>; 2] = Default::default();
+    let mut scored = 0;
+    for (p, r) in paths.iter().zip(recs) {
+        let Some(nav) = args.read.read_nav(p, r)? else {
+            continue;
+        };
+        if r.psi.is_none() {
+            continue;
+        }
+        for (i, (m, t)) in [(given, &before_t), (written, &after_t)].iter().enumerate() {
+            let e = evaluate(m, t, r, Some(&nav), &[], &SECS).map_err(bad)?;
+            for (secs, v) in &e.track_error_m {
+                if let Some(v) = v {
+                    let x = sums[i].entry(format!("{secs}")).or_insert((0.0, 0));
+                    x.0 += v;
+                    x.1 += 1;
+                }
+            }
+        }
+        scored += 1;
+    }
+    if scored == 0 {
+        eprintln!("note: no held-out record logs heading and navigation channels: the track error is not scored");
+        return Ok(None);
+    }
+    let mean = |m: &BTreeMap<String, (f64, usize)>| -> BTreeMap<String, f64> {
+        m.iter()
+            .map(|(k, (s, n))| (k.clone(), s / *n as f64))
+            .collect()
+    };
+    let (before, after) = (mean(&sums[0]), mean(&sums[1]));
+    let kept = match (before.get("60"), after.get("60")) {
+        (Some(b), Some(a)) => a < b,
+        _ => false,
+    };
+    let line = |m: &BTreeMap<String, f64>| {
+        SECS.iter()
+            .filter_map(|s| m.get(&format!("{s}")).map(|v| format!("{s} s {v:.2} m")))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    println!(
+        "track error on {scored} held-out record(s): before {}; with the current estimated {}{}",
+        line(&before),
+        line(&after),
+        if kept { "" } else { " (not kept)" }
+    );
+    let t = if kept { after_t } else { before_t };
+    Ok(Some((
+        TrackBeforeAfter {
+            before,
+            after,
+            kept,
+            records: scored,
+        },
+        t,
+    )))
 }
 
 /// The `more` object of the JSON summary: the search of `--more`.
@@ -293,13 +398,30 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
         .first()
         .or(est.first())
         .context("no record to check the export on")?;
-    let ex = super::pipeline::add_model(&mut outputs, written, &args.out, check)?;
+    let (track_report, track_part) = if kind == EffectKind::Current {
+        let held = if val.is_empty() {
+            (args.data.as_slice(), est.as_slice())
+        } else {
+            (args.validate.as_slice(), val.as_slice())
+        };
+        match track_current(args, &given, written, held)? {
+            Some((r, t)) => (Some(r), Some(t)),
+            None => (None, read_track(&args.model, &given)?),
+        }
+    } else {
+        (None, read_track(&args.model, &given)?)
+    };
+    let ex =
+        super::pipeline::add_model_with_track(&mut outputs, written, track_part, &args.out, check)?;
     let mut done = vec![format!(
         "model written to {} and {}{}",
         ex.blob_path.display(),
         ex.json_path.display(),
         describe_written(what)
     )];
+    if track_report.as_ref().is_some_and(|t| t.kept) {
+        done.push("its heading/track part now estimates the current".to_string());
+    }
 
     let mut ship_written = None;
     let mut sim_effect = None;
@@ -353,6 +475,7 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
             ship: ship_written,
             sim_effect,
             more: more.as_ref().map(MoreSummary::of),
+            track_error_m: track_report,
             effects: effect_names(written),
         },
     )?;
@@ -411,7 +534,9 @@ fn write_unchanged(
         .first()
         .or(est.first())
         .context("no record to check the export on")?;
-    let ex = super::pipeline::add_model(&mut outputs, written, &args.out, check)?;
+    // the model's heading/track part goes with it unchanged
+    let track = read_track(&args.model, given)?;
+    let ex = super::pipeline::add_model_with_track(&mut outputs, written, track, &args.out, check)?;
     let mut done = vec![if what == Written::Input {
         format!(
             "no effect to add: the input model is written unchanged to {}",

@@ -8,8 +8,10 @@ use clap::{Args, ValueEnum};
 use serde::Serialize;
 use yawcast::identify::model::Model;
 use yawcast::io::data::{self, Columns, Limits, Record};
+use yawcast::io::nav::{parse_nav_csv, Nav, NavColumns};
 use yawcast::io::nmea::{self, Clock, NmeaOptions};
 use yawcast_shared::blob::FORMAT_VERSION;
+use yawcast_shared::nav::TrackSpec;
 
 /// Marks an error as caused by the user's input (exit code 2).
 #[derive(Debug, thiserror::Error)]
@@ -93,6 +95,23 @@ pub struct ReadArgs {
     /// CSV column holding the relative wind angle from the bow (optional column).
     #[arg(long, value_name = "NAME", default_value = "wind_angle_deg")]
     pub col_wind_angle: String,
+    /// CSV column holding the course over ground in degrees (optional; with --col-speed it
+    /// gives the ground velocity of the heading and track prediction).
+    #[arg(long, value_name = "NAME", default_value = "cog_deg")]
+    pub col_cog: String,
+    /// CSV column holding the latitude in degrees (optional; position fixes, with --col-lon).
+    #[arg(long, value_name = "NAME", default_value = "lat_deg")]
+    pub col_lat: String,
+    /// CSV column holding the longitude in degrees (optional; with --col-lat).
+    #[arg(long, value_name = "NAME", default_value = "lon_deg")]
+    pub col_lon: String,
+    /// CSV column holding the position north of an origin in metres (optional; position
+    /// fixes, with --col-east, when there is no latitude/longitude).
+    #[arg(long, value_name = "NAME", default_value = "north_m")]
+    pub col_north: String,
+    /// CSV column holding the position east of an origin in metres (optional; with --col-north).
+    #[arg(long, value_name = "NAME", default_value = "east_m")]
+    pub col_east: String,
     /// Unit of the CSV angle columns (angle, heading, wind angle).
     #[arg(long, value_enum, default_value = "deg")]
     pub angle_unit: AngleUnit,
@@ -137,6 +156,11 @@ impl Default for ReadArgs {
             col_speed: "u_mps".into(),
             col_wind_speed: "wind_speed_mps".into(),
             col_wind_angle: "wind_angle_deg".into(),
+            col_cog: "cog_deg".into(),
+            col_lat: "lat_deg".into(),
+            col_lon: "lon_deg".into(),
+            col_north: "north_m".into(),
+            col_east: "east_m".into(),
             angle_unit: AngleUnit::Deg,
             rate_unit: RateUnit::Degps,
             nmea_rate: None,
@@ -253,6 +277,53 @@ impl ReadArgs {
         };
         data::validate_record(&rec, path, &self.limits()?, &cols)?;
         Ok(rec)
+    }
+
+    /// The CSV column mapping of the navigation channels.
+    pub fn nav_columns(&self) -> NavColumns {
+        NavColumns {
+            sog: self.col_speed.clone(),
+            cog: self.col_cog.clone(),
+            lat: self.col_lat.clone(),
+            lon: self.col_lon.clone(),
+            north: self.col_north.clone(),
+            east: self.col_east.clone(),
+        }
+    }
+
+    /// The navigation channels of the record `rec` read from `path` (speed and course over
+    /// ground, positions; from CSV columns or NMEA `VTG`, `RMC`, `GGA`): `Ok(None)` when the
+    /// file has none or was resampled (the heading and track prediction is then skipped,
+    /// never guessed; the caller says so).
+    ///
+    /// Errors name the file, row and column (bad input).
+    pub fn read_nav(&self, path: &Path, rec: &Record) -> Result<Option<Nav>> {
+        let bytes = std::fs::read(path)
+            .map_err(|e| bad(format!("{}: cannot read: {e}", path.display())))?;
+        let text = String::from_utf8_lossy(&bytes);
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        let is_nmea = match self.format {
+            Format::Nmea => true,
+            Format::Csv => false,
+            Format::Auto => {
+                matches!(ext.as_str(), "nmea" | "log" | "txt" | "nmea0183")
+                    || (ext != "csv" && nmea::looks_like_nmea(&text))
+            }
+        };
+        if is_nmea {
+            let nn = nmea::parse_nmea_nav(&text, path, &self.nmea(), rec)
+                .map_err(|e| bad(e.to_string()))?;
+            return Ok(yawcast::io::nav::from_nmea(rec, &nn));
+        }
+        // resampled records have no rows to match the navigation cells to
+        if self.resample.is_some() {
+            return Ok(None);
+        }
+        parse_nav_csv(&text, path, &self.nav_columns(), rec.len(), rec.ts)
+            .map_err(|e| bad(e.to_string()))
     }
 
     /// Reads several record files, in order.
@@ -460,6 +531,40 @@ pub fn read_model(path: &Path) -> Result<Model> {
     let bytes = std::fs::read(path)
         .map_err(|e| bad(format!("{}: cannot read the model: {e}", path.display())))?;
     model_from_bytes(&bytes, path)
+}
+
+/// The heading/track part of the model at `path`: from a format 3 blob, else from the
+/// `track` key of its JSON twin; `None` when the model has none. Bad input when it does not
+/// validate for the model's sample time.
+pub fn read_track(path: &Path, model: &Model) -> Result<Option<TrackSpec>> {
+    let is_json = path.extension().is_some_and(|e| e == "json");
+    if !is_json {
+        if let Ok(bytes) = std::fs::read(path) {
+            if let Ok((_, Some(t))) = yawcast_shared::blob::decode_blob_with_track(&bytes) {
+                return Ok(Some(t));
+            }
+        }
+    }
+    let twin = if is_json {
+        path.to_path_buf()
+    } else {
+        path.with_extension("json")
+    };
+    let Ok(text) = std::fs::read_to_string(&twin) else {
+        return Ok(None);
+    };
+    let v: serde_json::Value = match serde_json::from_str(&text) {
+        Ok(v) => v,
+        Err(_) => return Ok(None),
+    };
+    let Some(t) = v.get("track").filter(|t| !t.is_null()) else {
+        return Ok(None);
+    };
+    let t: TrackSpec = serde_json::from_value(t.clone())
+        .map_err(|e| bad(format!("{}: track: {e}", twin.display())))?;
+    t.validate(model.ts as f32)
+        .map_err(|e| bad(format!("{}: {e}", twin.display())))?;
+    Ok(Some(t))
 }
 
 /// [`read_model`] on the bytes of `path` (already read): a `.json` twin, or a blob with the

@@ -40,10 +40,63 @@ pub(super) fn add_model(
     out: &Path,
     check: &Record,
 ) -> Result<export::ExportReport> {
-    let (report, files) = export::prepare_with(model, out, check, &export::ExportConfig::default())
+    add_model_with_track(outputs, model, None, out, check)
+}
+
+/// [`add_model`] with the model's heading/track part (written into a format 3 blob and the
+/// twin's `track`).
+pub(super) fn add_model_with_track(
+    outputs: &mut Outputs,
+    model: &Model,
+    track: Option<yawcast_shared::nav::TrackSpec>,
+    out: &Path,
+    check: &Record,
+) -> Result<export::ExportReport> {
+    let cfg = export::ExportConfig {
+        track,
+        ..export::ExportConfig::default()
+    };
+    let (report, files) = export::prepare_with(model, out, check, &cfg)
         .with_context(|| format!("exporting the model {}", out.display()))?;
     outputs.extend(files);
     Ok(report)
+}
+
+/// The heading/track part fitted on the identification records when every one of them logs
+/// a heading and a ground velocity (speed and course over ground); `None` with a note
+/// otherwise (the track is then not predicted, never guessed).
+pub(super) fn track_from_records(
+    read: &super::common::ReadArgs,
+    model: &Model,
+    recs: &[Record],
+    paths: &[PathBuf],
+    current: bool,
+) -> Result<Option<yawcast_shared::nav::TrackSpec>> {
+    let mut navs = Vec::new();
+    for (r, p) in recs.iter().zip(paths) {
+        match read.read_nav(p, r)? {
+            Some(n) if n.has_velocity() && r.psi.is_some() => navs.push(n),
+            _ => {
+                eprintln!(
+                    "note: {}: no heading with speed and course over ground: the model gets no \
+                     heading/track part",
+                    p.display()
+                );
+                return Ok(None);
+            }
+        }
+    }
+    let pairs: Vec<(&Record, &yawcast::io::nav::Nav)> = recs.iter().zip(&navs).collect();
+    let t =
+        yawcast::identify::track::fit_track(model.ts, model.d_y(), &pairs, current).map_err(bad)?;
+    println!(
+        "track part: speed {:.3} m/s, speed loss {:.4} (m/s)/(deg/s)², sway {:.4} (m/s)/(deg/s){}",
+        t.speed,
+        t.speed_loss,
+        t.sway,
+        if current { ", current estimated" } else { "" }
+    );
+    Ok(Some(t))
 }
 
 /// The paths of `<out>.postcard` and `<out>.json`, when `--out` was given.
@@ -358,7 +411,8 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
     let mut done = None;
     if let Some(out) = &args.out {
         let check = val.first().unwrap_or(&recs[0]);
-        let r = add_model(&mut outputs, &model, out, check)?;
+        let track = track_from_records(&args.read, &model, &recs, &args.data, false)?;
+        let r = add_model_with_track(&mut outputs, &model, track, out, check)?;
         done = Some(format!(
             "model written to {} and {}",
             r.blob_path.display(),
@@ -801,8 +855,10 @@ pub fn export_cmd(args: &ExportArgs) -> Result<()> {
     let model = read_model(&args.model)?;
     let check = args.read.read(&args.data)?;
     super::common::check_record_for_model(&check, &model, &args.data)?;
+    // the model's heading/track part goes into the blob with it (format 3)
     let cfg = export::ExportConfig {
         golden: args.golden.clone(),
+        track: super::common::read_track(&args.model, &model)?,
         ..export::ExportConfig::default()
     };
     let (r, files) =

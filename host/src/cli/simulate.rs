@@ -5,7 +5,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use clap::Args;
+use rayon::prelude::*;
 use serde::Serialize;
+use yawcast::io::data::Record;
+use yawcast::io::nav::csv_text_with_nav;
 use yawcast::sim::{self, InputSpec, NoiseSpec, Scenario, Ship, SimEffect, World, WorldKind};
 use yawcast_shared::model::EffectKind;
 
@@ -238,13 +241,29 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let mut done = Vec::new();
     if args.out.is_some() {
         let seeds: Vec<u64> = (0..args.records as u64).map(|i| seed + i).collect();
-        let recs = match args.ship {
-            Some(_) => sim::simulate_many(&ship, &scenario, &seeds),
-            None => world.simulate_many(&scenario, &seeds),
+        // the built-in ship family also logs course over ground and position
+        let recs: Vec<(Record, Option<sim::SimNav>)> = if kind == WorldKind::Lng {
+            seeds
+                .par_iter()
+                .map(|&s| {
+                    sim::simulate_with_nav(&ship, &scenario, s).map(|(mut r, n)| {
+                        r.name = format!("{}-{s}", scenario.name);
+                        (r, Some(n))
+                    })
+                })
+                .collect::<Result<Vec<_>, _>>()
+        } else {
+            world
+                .simulate_many(&scenario, &seeds)
+                .map(|v| v.into_iter().map(|r| (r, None)).collect())
         }
         .map_err(bad)?;
-        for ((rec, s), path) in recs.iter().zip(&seeds).zip(&records) {
-            outputs.add(path, yawcast::io::data::csv_text(rec).into_bytes());
+        for (((rec, nav), s), path) in recs.iter().zip(&seeds).zip(&records) {
+            let text = match nav {
+                Some(n) => csv_text_with_nav(rec, &n.cog_deg, &n.north_m, &n.east_m),
+                None => yawcast::io::data::csv_text(rec),
+            };
+            outputs.add(path, text.into_bytes());
             done.push(format!(
                 "{}: {} samples at Ts = {} s, seed {s}",
                 path.display(),

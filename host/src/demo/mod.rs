@@ -187,10 +187,29 @@ pub struct Outcome {
     pub ship_note: String,
     /// Firmware checks.
     pub firmware: FirmwareCheck,
+    /// The heading and track prediction on a current case, or `None` when it failed.
+    pub track: Option<TrackCase>,
     /// Seconds per step.
     pub timings: Vec<(String, f64)>,
     /// Total seconds.
     pub seconds: f64,
+}
+
+/// The demo's current case: the conventional model with the heading/track part fitted on
+/// effect-free simulator records, scored on a record with a current, without and with the
+/// track's current estimate (`track` in the JSON summary).
+#[derive(Debug, Clone, Serialize)]
+pub struct TrackCase {
+    /// Current speed (m/s).
+    pub current_mps: f64,
+    /// The direction the current sets towards (deg).
+    pub towards_deg: f64,
+    /// Heading fit % of ψ̂(t+k|t) keyed by step horizon.
+    pub heading_fit: Fits,
+    /// Median track error (m) keyed by seconds ("30", "60", "120"), without the current.
+    pub before: Fits,
+    /// The same with the track's current estimate.
+    pub after: Fits,
 }
 
 /// The `fit` object of a model in the JSON summary.
@@ -223,6 +242,9 @@ pub struct Summary {
     pub ranking: Vec<Evidence>,
     /// Wall-clock seconds of the run.
     pub seconds: f64,
+    /// The heading and track prediction on a current case (absent when it failed).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub track: Option<TrackCase>,
 }
 
 impl Outcome {
@@ -250,6 +272,7 @@ impl Outcome {
             firmware_qemu: self.firmware.qemu_equal.is_some(),
             ranking: self.ranking.clone(),
             seconds: self.seconds,
+            track: self.track.clone(),
         }
     }
 }
@@ -490,6 +513,22 @@ pub(crate) mod tests {
                 host: ten.clone(),
                 firmware: ten.iter().map(|v| v + 1e-7).collect(),
             },
+            track: Some(TrackCase {
+                current_mps: 0.5,
+                towards_deg: 60.0,
+                heading_fit: HORIZON_KEYS[..4]
+                    .iter()
+                    .map(|k| (k.to_string(), 99.0))
+                    .collect(),
+                before: [("30", 7.0), ("60", 15.0), ("120", 33.0)]
+                    .iter()
+                    .map(|(k, v)| (k.to_string(), *v))
+                    .collect(),
+                after: [("30", 2.5), ("60", 6.0), ("120", 16.0)]
+                    .iter()
+                    .map(|(k, v)| (k.to_string(), *v))
+                    .collect(),
+            }),
             timings: vec![("simulate".into(), 1.0)],
             seconds: 12.5,
         }
@@ -538,6 +577,13 @@ pub(crate) mod tests {
             }
         }
         assert_eq!(v["firmware_bit_exact"], true);
+        assert_eq!(v["track"]["before"]["60"], 15.0);
+        assert_eq!(v["track"]["after"]["60"], 6.0);
+        let html = sample().report().render();
+        assert!(
+            html.contains("<section id=\"track\""),
+            "track section missing"
+        );
     }
 
     #[test]

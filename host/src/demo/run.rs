@@ -480,6 +480,14 @@ pub fn run(cfg: &DemoConfig, say: &mut dyn FnMut(&str)) -> Result<Outcome, DemoE
         .iter()
         .map(|w| (w.record.clone(), w.t_start, w.t_end, w.rmse, w.what.clone()))
         .collect();
+    let track = match track_case(&cfg.ship, &conventional.model, seed) {
+        Ok(t) => Some(t),
+        Err(e) => {
+            say(&format!("heading and track case skipped: {e}"));
+            None
+        }
+    };
+    tick("heading and track", &mut timings);
     Ok(Outcome {
         seed,
         ship: cfg.ship.name.clone(),
@@ -507,8 +515,67 @@ pub fn run(cfg: &DemoConfig, say: &mut dyn FnMut(&str)) -> Result<Outcome, DemoE
         ship_after,
         ship_note,
         firmware,
+        track,
         timings,
         seconds: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// The demo's current case ([`super::TrackCase`]): the track part fitted on three effect-free
+/// records of `ship`, a record with a 0.5 m/s current setting towards 60°, the model's
+/// heading fit and track error without and with the track's current estimate.
+fn track_case(ship: &Ship, model: &Model, seed: u64) -> Result<super::TrackCase, String> {
+    use crate::identify::track::{evaluate, fit_track};
+    use crate::io::nav::{ground_velocity, Nav};
+    let with_nav = |sc: &Scenario, s: u64| -> Result<(Record, Nav), String> {
+        let (rec, sn) = sim::simulate_with_nav(ship, sc, s).map_err(|e| e.to_string())?;
+        let sog = rec.speed.clone().ok_or("no speed over ground")?;
+        let v = sog
+            .iter()
+            .zip(&sn.cog_deg)
+            .map(|(u, c)| ground_velocity(*u, *c))
+            .collect();
+        let fix = sn
+            .north_m
+            .iter()
+            .zip(&sn.east_m)
+            .map(|(n, e)| [*n, *e])
+            .collect();
+        let nav = Nav::new(rec.ts, Some(v), Some(fix), "simulator").ok_or("no channels")?;
+        Ok((rec, nav))
+    };
+    let base = seed.wrapping_mul(1000).wrapping_add(900);
+    let refs = (1..=3)
+        .map(|i| with_nav(&Scenario::default(), base + i))
+        .collect::<Result<Vec<_>, _>>()?;
+    let pairs: Vec<(&Record, &Nav)> = refs.iter().map(|(r, n)| (r, n)).collect();
+    let plain = fit_track(model.ts, model.d_y(), &pairs, false)?;
+    let current = fit_track(model.ts, model.d_y(), &pairs, true)?;
+    let (current_mps, towards_deg) = (0.5, 60.0);
+    let sc = Scenario::with_effect(SimEffect::Current {
+        speed_mps: current_mps,
+        towards_deg,
+    });
+    let (rec, nav) = with_nav(&sc, base + 4)?;
+    let secs = [30.0, 60.0, 120.0];
+    let before = evaluate(model, &plain, &rec, Some(&nav), &[1, 5, 10, 20], &secs)?;
+    let after = evaluate(model, &current, &rec, Some(&nav), &[], &secs)?;
+    let keyed = |e: &crate::identify::track::TrackEval| -> Fits {
+        e.track_error_m
+            .iter()
+            .filter_map(|(s, m)| m.map(|m| (format!("{s}"), m)))
+            .collect()
+    };
+    Ok(super::TrackCase {
+        current_mps,
+        towards_deg,
+        heading_fit: before
+            .heading_fit
+            .iter()
+            .map(|(k, f)| (k.to_string(), *f))
+            .collect(),
+        before: keyed(&before),
+        after: keyed(&after),
     })
 }
 

@@ -5,3 +5,4 @@ pub mod merge;
 pub mod model;
 pub mod pem;
 pub mod predict;
+pub mod track;

@@ -28,8 +28,9 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 use yawcast_firmware::PredictorError;
-use yawcast_shared::blob::{self, FORMAT_VERSION, MAX_BLOB_LEN};
+use yawcast_shared::blob::{self, FORMAT_VERSION, MAX_BLOB_LEN, MODEL_ONLY_VERSION};
 use yawcast_shared::model::ModelSpec;
+use yawcast_shared::nav::TrackSpec;
 
 use crate::identify::model::Model;
 use crate::identify::predict::{self, Horizon};
@@ -50,6 +51,9 @@ pub struct ExportConfig {
     pub golden: Option<PathBuf>,
     /// Horizon of the golden vectors (default 20).
     pub golden_horizon: usize,
+    /// The model's heading/track part: written into the blob (format 3) and the twin
+    /// (`track`); `None` writes a format 2 blob as before.
+    pub track: Option<TrackSpec>,
 }
 
 impl Default for ExportConfig {
@@ -59,6 +63,7 @@ impl Default for ExportConfig {
             tolerance_pp: 0.01,
             golden: None,
             golden_horizon: 20,
+            track: None,
         }
     }
 }
@@ -93,6 +98,9 @@ pub struct ModelJson {
     pub fit: BTreeMap<String, f64>,
     /// Firmware fit % on the check record per horizon.
     pub firmware_fit: BTreeMap<String, f64>,
+    /// The heading/track part, when the model has one (blob format 3).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub track: Option<TrackSpec>,
 }
 
 /// What [`export`] did.
@@ -323,11 +331,16 @@ pub fn prepare_with(
         .to_spec()
         .map_err(|e| ExportError::Model(e.to_string()))?;
     let mut buf = [0u8; MAX_BLOB_LEN];
-    let blob_bytes = blob::encode_blob(&spec, &mut buf)
+    let blob_bytes = blob::encode_blob_with_track(&spec, cfg.track.as_ref(), &mut buf)
         .map_err(|e| ExportError::Model(e.to_string()))?
         .to_vec();
-    let spec_back = blob::decode_blob(&blob_bytes)
+    let (spec_back, track_back) = blob::decode_blob_with_track(&blob_bytes)
         .map_err(|e| ExportError::Blob(format!("does not read back: {e}")))?;
+    if track_back != cfg.track {
+        return Err(ExportError::Blob(
+            "the track part does not read back".into(),
+        ));
+    }
     let hmax = cfg
         .horizons
         .iter()
@@ -396,7 +409,11 @@ pub fn prepare_with(
     let json = ModelJson {
         format: "yawcast-model".into(),
         format_version: JSON_FORMAT_VERSION,
-        blob_format_version: FORMAT_VERSION,
+        blob_format_version: if cfg.track.is_some() {
+            FORMAT_VERSION
+        } else {
+            MODEL_ONLY_VERSION
+        },
         model: model.clone(),
         param_names: model.param_names(),
         check_record: check.name.clone(),
@@ -408,6 +425,7 @@ pub fn prepare_with(
             .iter()
             .map(|c| (c.horizon.to_string(), c.firmware_fit))
             .collect(),
+        track: cfg.track,
     };
     let json_text =
         serde_json::to_string_pretty(&json).map_err(|e| ExportError::Blob(format!("JSON: {e}")))?;

@@ -4,5 +4,6 @@
 pub mod data;
 pub mod export;
 pub mod hil;
+pub mod nav;
 pub mod nmea;
 pub mod report;

@@ -8,9 +8,15 @@
 //! | `$--RSA` rudder sensor angle | angle `δ` (required) | deg; both sensors valid → their mean |
 //! | `$--HDT` true heading | heading `ψ` | deg (unwrapped) |
 //! | `$--HDG` magnetic heading | heading `ψ` when no HDT | sensor + deviation + variation (E +) |
-//! | `$--VTG` course/speed over ground | speed `u` | knots (or km/h) → m/s |
+//! | `$--VTG` course/speed over ground | speed `u`; course (navigation) | knots (or km/h) → m/s; deg true |
 //! | `$--MWV` wind speed and angle | relative wind | `R` reference only; N/M/K/S → m/s |
 //! | `$--ZDA`, `$--RMC` | the clock | UTC time and date |
+//! | `$--GGA` (else `$--RMC`) | position (navigation) | latitude, longitude in degrees (valid fixes only) |
+//! | `$--RMC` | course (navigation) when there is no `VTG` | deg true |
+//!
+//! The navigation channels (course over ground, position) never shape the record: they are
+//! read by [`parse_nmea_nav`] onto the record's own grid, a gap in them leaving `NaN` (a
+//! skipped correction) rather than an error.
 //!
 //! HDT, VTG, MWV, ZDA and RMC are parsed by the `nmea` crate; ROT, RSA and HDG by the small
 //! parsers here ([`parse_rot`], [`parse_rsa`], [`parse_hdg`]). Other sentences are checked
@@ -307,9 +313,19 @@ enum Chan {
     Speed,
     WindSpeed,
     WindAngle,
+    /// Course over ground (navigation).
+    Course,
+    /// Latitude (navigation).
+    Lat,
+    /// Longitude (navigation).
+    Lon,
 }
 
 impl Chan {
+    /// The navigation channels, read beside the record, never into it.
+    fn is_nav(self) -> bool {
+        matches!(self, Chan::Course | Chan::Lat | Chan::Lon)
+    }
     fn sentence(self) -> &'static str {
         match self {
             Chan::Rate => "ROT",
@@ -317,6 +333,8 @@ impl Chan {
             Chan::Heading => "HDT/HDG",
             Chan::Speed => "VTG",
             Chan::WindSpeed | Chan::WindAngle => "MWV",
+            Chan::Course => "VTG/RMC",
+            Chan::Lat | Chan::Lon => "GGA/RMC",
         }
     }
     fn what(self) -> &'static str {
@@ -327,10 +345,13 @@ impl Chan {
             Chan::Speed => "speed over ground",
             Chan::WindSpeed => "relative wind speed",
             Chan::WindAngle => "relative wind angle",
+            Chan::Course => "course over ground",
+            Chan::Lat => "latitude",
+            Chan::Lon => "longitude",
         }
     }
     fn angular(self) -> bool {
-        matches!(self, Chan::Heading | Chan::WindAngle)
+        matches!(self, Chan::Heading | Chan::WindAngle | Chan::Course)
     }
 }
 
@@ -397,9 +418,112 @@ pub fn parse_nmea(
             }
         }
     }
-    let items = scan(text, path, opts)?;
+    let items: Vec<(usize, Item)> = scan(text, path, opts)?
+        .into_iter()
+        .filter(|(_, it)| !matches!(it, Item::Value(c, _) if c.is_nav()))
+        .collect();
     let series = timestamp(&items, path, opts)?;
     resample(series, path, name, opts)
+}
+
+/// The navigation channels of an NMEA log on the grid of its record `rec` (as
+/// [`parse_nmea`] made it with the same options): the course over ground (deg) and the
+/// position `[lat, lon]` (deg), each `None` when the log has none. Grid points outside a
+/// channel's span or inside a hole longer than the gap limit are `NaN` (missing).
+///
+/// # Errors
+/// As [`parse_nmea`] (the same log is read).
+pub fn parse_nmea_nav(
+    text: &str,
+    path: &Path,
+    opts: &NmeaOptions,
+    rec: &Record,
+) -> Result<NmeaNav, NmeaError> {
+    let items = scan(text, path, opts)?;
+    let series = timestamp(&items, path, opts)?;
+    // the record's grid starts where every record channel has data (as in `resample`)
+    let t_start = series
+        .iter()
+        .filter(|(c, _)| !c.is_nav())
+        .map(|(_, v)| v[0].0)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let grid: Vec<f64> = (0..rec.len())
+        .map(|i| t_start + i as f64 * rec.ts)
+        .collect();
+    let on_grid = |c: Chan| -> Option<Vec<f64>> {
+        let v = series.get(&c)?;
+        let limit = opts
+            .max_gap
+            .unwrap_or((2.0 * rec.ts).max(2.5 * median_step(v)));
+        Some(interp_gaps(v, &grid, c.angular(), limit))
+    };
+    let course = on_grid(Chan::Course);
+    let position = match (on_grid(Chan::Lat), on_grid(Chan::Lon)) {
+        (Some(la), Some(lo)) => Some(la.into_iter().zip(lo).map(|(a, b)| [a, b]).collect()),
+        _ => None,
+    };
+    Ok(NmeaNav { course, position })
+}
+
+/// The navigation channels of an NMEA log on its record's grid ([`parse_nmea_nav`]).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct NmeaNav {
+    /// Course over ground (deg true), `NaN` where missing.
+    pub course: Option<Vec<f64>>,
+    /// Position `[latitude, longitude]` (deg), `NaN` where missing.
+    pub position: Option<Vec<[f64; 2]>>,
+}
+
+/// The median positive spacing of a channel's samples (s).
+fn median_step(v: &[(f64, f64, usize)]) -> f64 {
+    let mut d: Vec<f64> = v
+        .windows(2)
+        .map(|w| w[1].0 - w[0].0)
+        .filter(|d| *d > 0.0)
+        .collect();
+    if d.is_empty() {
+        return f64::INFINITY;
+    }
+    d.sort_by(f64::total_cmp);
+    d[d.len() / 2]
+}
+
+/// Linear interpolation of `v` at `grid` (angular channels unwrapped first), `NaN` outside
+/// the samples' span and inside holes longer than `limit`; no rounding (positions).
+fn interp_gaps(v: &[(f64, f64, usize)], grid: &[f64], angular: bool, limit: f64) -> Vec<f64> {
+    let mut ts: Vec<f64> = Vec::with_capacity(v.len());
+    let mut xs: Vec<f64> = Vec::with_capacity(v.len());
+    for &(t, x, _) in v {
+        let x = match (angular, xs.last()) {
+            (true, Some(&prev)) => prev + (x - prev + 180.0).rem_euclid(360.0) - 180.0,
+            _ => x,
+        };
+        if ts.last() == Some(&t) {
+            if let Some(l) = xs.last_mut() {
+                *l = x;
+            }
+        } else {
+            ts.push(t);
+            xs.push(x);
+        }
+    }
+    let mut j = 0;
+    grid.iter()
+        .map(|&g| {
+            if ts.len() < 2 || g < ts[0] || g > ts[ts.len() - 1] {
+                return f64::NAN;
+            }
+            while j + 2 < ts.len() && ts[j + 1] < g {
+                j += 1;
+            }
+            let (t0, t1) = (ts[j], ts[j + 1]);
+            if t1 - t0 > limit {
+                return f64::NAN;
+            }
+            let w = ((g - t0) / (t1 - t0)).clamp(0.0, 1.0);
+            xs[j] + w * (xs[j + 1] - xs[j])
+        })
+        .collect()
 }
 
 /// Pass 1: every line → items, checksums verified.
@@ -410,6 +534,8 @@ fn scan(text: &str, path: &Path, opts: &NmeaOptions) -> Result<Vec<(usize, Item)
     let mut out = Vec::new();
     let has_hdt = text.contains("HDT,");
     let has_zda = text.contains("ZDA,");
+    let has_vtg = text.contains("VTG,");
+    let has_gga = text.contains("GGA,");
     for (i, raw) in text.lines().enumerate() {
         let line = i + 1;
         let Some(start) = raw.find('$') else {
@@ -472,7 +598,7 @@ fn scan(text: &str, path: &Path, opts: &NmeaOptions) -> Result<Vec<(usize, Item)
                     out.push((line, Item::Value(Chan::Heading, v)));
                 }
             }
-            "HDT" | "VTG" | "MWV" | "ZDA" | "RMC" => {
+            "HDT" | "VTG" | "MWV" | "ZDA" | "RMC" | "GGA" => {
                 let parsed = nmea::parse_str(s)
                     .map_err(|e| malformed(format!("cannot read the sentence ({e:?})")))?;
                 match parsed {
@@ -484,6 +610,17 @@ fn scan(text: &str, path: &Path, opts: &NmeaOptions) -> Result<Vec<(usize, Item)
                     nmea::ParseResult::VTG(v) => {
                         if let Some(kn) = v.speed_over_ground {
                             out.push((line, Item::Value(Chan::Speed, knots(f64::from(kn)))));
+                        }
+                        if let Some(c) = v.true_course {
+                            out.push((line, Item::Value(Chan::Course, f64::from(c))));
+                        }
+                    }
+                    nmea::ParseResult::GGA(g) => {
+                        use nmea::sentences::FixType;
+                        let valid = !matches!(g.fix_type, None | Some(FixType::Invalid));
+                        if let (true, Some(la), Some(lo)) = (valid, g.latitude, g.longitude) {
+                            out.push((line, Item::Value(Chan::Lat, la)));
+                            out.push((line, Item::Value(Chan::Lon, lo)));
                         }
                     }
                     nmea::ParseResult::MWV(w) => {
@@ -515,17 +652,29 @@ fn scan(text: &str, path: &Path, opts: &NmeaOptions) -> Result<Vec<(usize, Item)
                             out.push((line, Item::Clock(clock_seconds(t, day))));
                         }
                     }
-                    nmea::ParseResult::RMC(r) if opts.clock == Clock::Log && !has_zda => {
-                        if let Some(t) = r.fix_time {
-                            use chrono::Datelike;
-                            let day = r.fix_date.map(|d| {
-                                days_from_civil(
-                                    i64::from(d.year()),
-                                    i64::from(d.month()),
-                                    i64::from(d.day()),
-                                )
-                            });
-                            out.push((line, Item::Clock(clock_seconds(t, day.flatten()))));
+                    nmea::ParseResult::RMC(r) => {
+                        if opts.clock == Clock::Log && !has_zda {
+                            if let Some(t) = r.fix_time {
+                                use chrono::Datelike;
+                                let day = r.fix_date.map(|d| {
+                                    days_from_civil(
+                                        i64::from(d.year()),
+                                        i64::from(d.month()),
+                                        i64::from(d.day()),
+                                    )
+                                });
+                                out.push((line, Item::Clock(clock_seconds(t, day.flatten()))));
+                            }
+                        }
+                        use nmea::sentences::rmc::RmcStatusOfFix;
+                        if r.status_of_fix != RmcStatusOfFix::Invalid {
+                            if let (false, Some(la), Some(lo)) = (has_gga, r.lat, r.lon) {
+                                out.push((line, Item::Value(Chan::Lat, la)));
+                                out.push((line, Item::Value(Chan::Lon, lo)));
+                            }
+                            if let (false, Some(c)) = (has_vtg, r.true_course) {
+                                out.push((line, Item::Value(Chan::Course, f64::from(c))));
+                            }
                         }
                     }
                     _ => {}
@@ -801,6 +950,8 @@ fn resample(
             Chan::WindAngle => {
                 rec.wind_angle = Some(vals.into_iter().map(|a| a.rem_euclid(360.0)).collect())
             }
+            // read by parse_nmea_nav, filtered out before
+            Chan::Course | Chan::Lat | Chan::Lon => {}
         }
     }
     Ok(rec)

@@ -354,6 +354,39 @@ pub(crate) fn run(
 /// assert!((mean(&rec.y) - mean(&base.y) - 0.25).abs() < 1e-9);
 /// ```
 pub fn simulate(ship: &Ship, scenario: &Scenario, seed: u64) -> Result<Record, SimError> {
+    simulate_with_nav(ship, scenario, seed).map(|(rec, _)| rec)
+}
+
+/// The navigation channels of a simulated record, one value per sample: course over ground
+/// (deg, in `[0, 360)`) and position north/east of the record's start (m), without noise.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SimNav {
+    /// Course over ground (deg).
+    pub cog_deg: Vec<f64>,
+    /// Position north of the start (m).
+    pub north_m: Vec<f64>,
+    /// Position east of the start (m).
+    pub east_m: Vec<f64>,
+}
+
+/// [`simulate`], also returning the navigation channels (course over ground and position);
+/// the record is the same.
+///
+/// # Errors
+/// As [`simulate`].
+///
+/// ```
+/// use yawcast::sim::{simulate_with_nav, Scenario, Ship, SimEffect};
+/// let sc = Scenario::with_effect(SimEffect::Current { speed_mps: 0.5, towards_deg: 90.0 });
+/// let (rec, nav) = simulate_with_nav(&Ship::default_lng(), &sc, 2).unwrap();
+/// assert_eq!(nav.north_m.len(), rec.len());
+/// assert_eq!((nav.north_m[0], nav.east_m[0]), (0.0, 0.0));
+/// ```
+pub fn simulate_with_nav(
+    ship: &Ship,
+    scenario: &Scenario,
+    seed: u64,
+) -> Result<(Record, SimNav), SimError> {
     ship.validate()?;
     scenario.validate()?;
     let effects = merged_effects(ship, &scenario.effects);
@@ -426,6 +459,13 @@ pub fn simulate(ship: &Ship, scenario: &Scenario, seed: u64) -> Result<Record, S
     }
     let mut nr = inputs::rng(seed, inputs::STREAM_NOISE);
     let ns = scenario.noise;
+    let mut nav = SimNav::default();
+    for (s, _) in &states {
+        nav.cog_deg
+            .push((s[5] + s[1].atan2(s[0])).to_degrees().rem_euclid(360.0));
+        nav.north_m.push(s[3]);
+        nav.east_m.push(s[4]);
+    }
     for (k, (s, app)) in states.iter().enumerate() {
         rec.u.push(cmds[k]);
         let g = if ns.gyro_std_degps > 0.0 {
@@ -449,7 +489,7 @@ pub fn simulate(ship: &Ship, scenario: &Scenario, seed: u64) -> Result<Record, S
         push(&mut rec.wind_speed, app.speed);
         push(&mut rec.wind_angle, app.angle.to_degrees());
     }
-    Ok(rec)
+    Ok((rec, nav))
 }
 
 fn push(v: &mut Option<Vec<f64>>, x: f64) {

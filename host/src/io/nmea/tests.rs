@@ -140,3 +140,33 @@ fn clear_errors() {
     assert!(e.contains("line 2: clock goes back"), "{e}");
     assert!(!looks_like_nmea(""));
 }
+
+#[test]
+fn navigation_channels_on_the_record_grid() {
+    let opts = NmeaOptions::default();
+    let r = parse(TRIAL, &opts).unwrap();
+    let nn = parse_nmea_nav(TRIAL, Path::new("trial.nmea"), &opts, &r).unwrap();
+    // VTG's true course, on every grid point
+    let c = nn.course.as_ref().unwrap();
+    assert_eq!(c.len(), 19);
+    assert!(c.iter().all(|&v| v == 45.0), "{c:?}");
+    // the one GGA fix comes before the first clock sentence and is dropped (and with a GGA
+    // in the log, RMC positions are not used): no position, never a guess
+    assert!(nn.position.is_none());
+    // without GGA the RMC positions serve: 53°46.8' N, 19°34.6' E
+    let rmc_only: String = TRIAL
+        .lines()
+        .filter(|l| !l.contains("GGA"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let r2 = parse(&rmc_only, &opts).unwrap();
+    assert_eq!(r2, r, "the navigation sentences do not change the record");
+    let nn = parse_nmea_nav(&rmc_only, Path::new("trial.nmea"), &opts, &r2).unwrap();
+    let p = nn.position.clone().unwrap();
+    assert!((p[3][0] - (53.0 + 46.8 / 60.0)).abs() < 1e-9, "{:?}", p[3]);
+    assert!((p[3][1] - (19.0 + 34.6 / 60.0)).abs() < 1e-9, "{:?}", p[3]);
+    let nav = crate::io::nav::from_nmea(&r2, &nn).unwrap();
+    // 3 kn along 45°: equal north and east components
+    let v = nav.velocity(5).unwrap();
+    assert!((v[0] - v[1]).abs() < 1e-9 && (v[0] - 1.543333 * 0.5f64.sqrt()).abs() < 1e-6);
+}
