@@ -1,0 +1,571 @@
+//! Inputs: help, arguments, CSV and NMEA reading and their errors, records the model cannot use, navigation channels.
+
+use crate::common::*;
+
+#[test]
+fn help_lists_every_subcommand() {
+    let o = run(&["--help"]);
+    assert_eq!(code(&o), 0);
+    let out = stdout(&o);
+    for c in [
+        "simulate", "identify", "tune", "average", "export", "compare", "resid", "diagnose",
+        "augment", "demo", "hil",
+    ] {
+        assert!(
+            out.lines().any(|l| l.trim_start().starts_with(c)),
+            "`{c}` missing from --help:\n{out}"
+        );
+    }
+}
+
+#[test]
+fn bad_arguments_exit_2() {
+    let o = run(&["compare", "--no-such-flag"]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    let o = run(&["no-such-command"]);
+    assert_eq!(code(&o), 2);
+}
+
+#[test]
+fn missing_file_is_bad_input_naming_it() {
+    let d = scratch("missing");
+    let m = write_model(&d);
+    let o = run(&[
+        "compare",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        "/nonexistent/trial.csv",
+    ]);
+    assert_eq!(code(&o), 2);
+    let e = stderr(&o);
+    assert!(e.starts_with("error: "), "{e}");
+    assert!(e.contains("/nonexistent/trial.csv"), "{e}");
+}
+
+#[test]
+fn csv_errors_name_file_row_and_column() {
+    let d = scratch("csverr");
+    let m = write_model(&d);
+    let cases: [(&str, String, &[&str]); 3] = [
+        (
+            "missing.csv",
+            "t_s,delta_deg\n0,1\n0.5,1\n".into(),
+            &["missing.csv", "missing column `r_degps`"],
+        ),
+        (
+            "nan.csv",
+            csv_text(40, 0.5).replacen("\n2.5,", "\n2.5,NaN_", 1),
+            &["nan.csv", "row 6", "delta_deg"],
+        ),
+        (
+            // a stamp 1 s late at 0.5 s sampling (jitter within half a period is accepted)
+            "nonuniform.csv",
+            csv_text(40, 0.5).replacen("\n3,", "\n4,", 1),
+            &["nonuniform.csv", "row 7", "uniform", "2 samples missing"],
+        ),
+    ];
+    for (name, text, needles) in cases {
+        let f = d.join(name);
+        std::fs::write(&f, text).unwrap();
+        let o = run(&[
+            "compare",
+            "--model",
+            m.to_str().unwrap(),
+            "--data",
+            f.to_str().unwrap(),
+        ]);
+        let e = stderr(&o);
+        assert_eq!(code(&o), 2, "{name}: {e}");
+        let first = e.lines().next().unwrap_or("");
+        for n in needles {
+            assert!(first.contains(n), "{name}: `{n}` not in first line: {e}");
+        }
+    }
+}
+
+#[test]
+fn custom_columns_and_units() {
+    let d = scratch("cols");
+    let m = write_model(&d);
+    // Same data in radians and rad/s under other names: the fit must be identical.
+    let deg = csv_text(60, 0.5);
+    let mut rad = String::from("time,rudder,rot\n");
+    for l in deg.lines().skip(1) {
+        let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+        rad.push_str(&format!(
+            "{},{},{}\n",
+            v[0],
+            v[1].to_radians(),
+            v[2].to_radians()
+        ));
+    }
+    std::fs::write(d.join("deg.csv"), deg).unwrap();
+    std::fs::write(d.join("rad.csv"), rad).unwrap();
+    let j1 = d.join("deg.json");
+    let j2 = d.join("rad.json");
+    let o = run(&[
+        "compare",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        d.join("deg.csv").to_str().unwrap(),
+        "--json",
+        j1.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let o = run(&[
+        "compare",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        d.join("rad.csv").to_str().unwrap(),
+        "--col-time",
+        "time",
+        "--col-delta",
+        "rudder",
+        "--col-rate",
+        "rot",
+        "--angle-unit",
+        "rad",
+        "--rate-unit",
+        "radps",
+        "--json",
+        j2.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let a: serde_json::Value = serde_json::from_slice(&std::fs::read(j1).unwrap()).unwrap();
+    let b: serde_json::Value = serde_json::from_slice(&std::fs::read(j2).unwrap()).unwrap();
+    for h in ["1", "5", "10", "20", "sim"] {
+        let fa = a["mean_fit"][h].as_f64().unwrap();
+        let fb = b["mean_fit"][h].as_f64().unwrap();
+        assert!((fa - fb).abs() < 1e-6, "{h}: {fa} vs {fb}");
+    }
+    // Pinned field names of the compare summary.
+    assert_eq!(a["command"], "compare");
+    assert!(a["records"][0]["name"].is_string());
+    assert!(a["records"][0]["samples"].is_u64());
+    assert!(a["records"][0]["fit"]["5"].is_f64());
+}
+
+#[test]
+fn nmea_logs_are_read_and_their_errors_named() {
+    let d = scratch("nmea");
+    let p = d.join("m.json");
+    std::fs::write(
+        &p,
+        r#"{"n":2,"ts":0.5,"a":[-0.2,0.7],"b":[0.01,0.02],"k":[0.5,0.2],"effects":[]}"#,
+    )
+    .unwrap();
+    let log = data_dir().join("trial.nmea");
+    let o = run(&[
+        "compare",
+        "--model",
+        p.to_str().unwrap(),
+        "--data",
+        log.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(stdout(&o).contains("trial"), "{}", stdout(&o));
+
+    let bad = data_dir().join("trial-bad-checksum.nmea");
+    let o = run(&[
+        "compare",
+        "--model",
+        p.to_str().unwrap(),
+        "--data",
+        bad.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 2);
+    assert!(
+        stderr(&o).contains("line 49: bad checksum"),
+        "{}",
+        stderr(&o)
+    );
+
+    let gap = data_dir().join("trial-gap.nmea");
+    let o = run(&[
+        "compare",
+        "--model",
+        p.to_str().unwrap(),
+        "--data",
+        gap.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 2);
+    assert!(
+        stderr(&o).contains("gap of 3.50 s in ROT (rate of turn) after 12:00:03.50"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn model_and_data_must_agree() {
+    let d = scratch("mismatch");
+    let m = write_model(&d);
+    let f = d.join("ts1.csv");
+    std::fs::write(&f, csv_text(60, 1.0)).unwrap();
+    let o = run(&[
+        "compare",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        f.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 2);
+    assert!(stderr(&o).contains("sampled every 1 s, the model every 0.5 s"));
+    let bad_model = d.join("bad.json");
+    std::fs::write(
+        &bad_model,
+        r#"{"n":2,"ts":0.5,"a":[1.0],"b":[0,0],"k":[0,0]}"#,
+    )
+    .unwrap();
+    let o = run(&[
+        "compare",
+        "--model",
+        bad_model.to_str().unwrap(),
+        "--data",
+        f.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 2);
+    assert!(stderr(&o).contains("bad.json"), "{}", stderr(&o));
+}
+
+/// Records that cannot be right are refused before any work, with the file, row and column
+/// named, exit 2 and no output written: a corrupted cell (3.4e200, which once made
+/// `identify` run forever), a rudder angle of 2e6°, an all-zero trial, a yaw rate stuck at
+/// zero, a command that never moves, a duplicated column; and a `;`-separated file with
+/// decimal commas is read.
+#[test]
+fn implausible_or_still_records_are_refused_before_any_work() {
+    let d = scratch("plausible");
+    let good = csv_text(200, 0.5);
+    let mut lines: Vec<String> = good.lines().map(String::from).collect();
+    let cases: Vec<(&str, String, &str, &str)> = {
+        let mut corrupt = lines.clone();
+        corrupt[40] = format!("{},10,3.4e200", 39.0 * 0.5);
+        let mut rudder = lines.clone();
+        rudder[12] = format!("{},2000000,0.01", 11.0 * 0.5);
+        let zero: String = std::iter::once("t_s,delta_deg,r_degps".to_string())
+            .chain((0..200).map(|i| format!("{},0,0", f64::from(i) * 0.5)))
+            .collect::<Vec<_>>()
+            .join("\n");
+        let stuck: String = std::iter::once("t_s,delta_deg,r_degps".to_string())
+            .chain((0..200).map(|i| {
+                let u = if (i / 7) % 2 == 0 { 10 } else { -10 };
+                format!("{},{u},0", f64::from(i) * 0.5)
+            }))
+            .collect::<Vec<_>>()
+            .join("\n");
+        let mut dup = lines.clone();
+        dup[0] = "t_s,delta_deg,r_degps,r_degps".into();
+        for l in dup.iter_mut().skip(1) {
+            l.push_str(",0");
+        }
+        vec![
+            ("corrupt", corrupt.join("\n"), "row 40", "r_degps"),
+            ("rudder", rudder.join("\n"), "row 12", "delta_deg"),
+            ("zero", zero, "constant", "delta_deg"),
+            ("stuck", stuck, "constant", "r_degps"),
+            ("dup", dup.join("\n"), "more than once", "r_degps"),
+        ]
+    };
+    for (name, text, what, col) in &cases {
+        let f = d.join(format!("{name}.csv"));
+        std::fs::write(&f, text).unwrap();
+        let out = d.join(format!("{name}-model"));
+        let o = run(&[
+            "identify",
+            "--data",
+            f.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let e = stderr(&o);
+        assert_eq!(code(&o), 2, "{name}: {e}");
+        assert!(e.contains(&format!("{name}.csv")), "{name}: {e}");
+        assert!(e.contains(what) && e.contains(col), "{name}: {e}");
+        assert!(!out.with_extension("postcard").exists(), "{name}");
+        assert!(!out.with_extension("json").exists(), "{name}");
+    }
+    // The limit is the user's to raise (a positive number).
+    let m = write_model(&d);
+    let f = d.join("rudder.csv");
+    let o = run(&[
+        "compare",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        f.to_str().unwrap(),
+        "--max-angle",
+        "3e6",
+    ]);
+    // Read now, the 2e6° command drives the model's prediction far off: a numerical failure
+    // naming the record (exit 1), never a fit of −1e6 % printed as a result.
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("rudder.csv") && stderr(&o).contains("diverges"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!stdout(&o).contains("fit@"), "{}", stdout(&o));
+    let o = run(&[
+        "compare",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        f.to_str().unwrap(),
+        "--max-angle",
+        "-1",
+    ]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("--max-angle"), "{}", stderr(&o));
+    // A `;`-separated file with decimal commas reads as its comma twin.
+    lines[0] = "t_s;delta_deg;r_degps".into();
+    for l in lines.iter_mut().skip(1) {
+        *l = l.replace(',', ";").replace('.', ",");
+    }
+    std::fs::write(d.join("semi.csv"), lines.join("\n")).unwrap();
+    std::fs::write(d.join("comma.csv"), &good).unwrap();
+    let fits: Vec<String> = ["semi.csv", "comma.csv"]
+        .iter()
+        .map(|f| {
+            let o = run(&[
+                "compare",
+                "--model",
+                m.to_str().unwrap(),
+                "--data",
+                d.join(f).to_str().unwrap(),
+            ]);
+            assert_eq!(code(&o), 0, "{f}: {}", stderr(&o));
+            stdout(&o)
+                .lines()
+                .last()
+                .unwrap()
+                .split_whitespace()
+                .skip(1)
+                .collect()
+        })
+        .collect();
+    assert_eq!(fits[0], fits[1]);
+}
+
+/// A horizon as long as the record is bad input, named with the record, and nothing is written.
+#[test]
+fn compare_refuses_horizons_as_long_as_the_record() {
+    let d = scratch("diverge");
+    let m = write_model(&d);
+    let f = d.join("r.csv");
+    std::fs::write(&f, csv_text(200, 0.5)).unwrap();
+    let args = |h: &str| {
+        vec![
+            "compare".to_string(),
+            "--model".into(),
+            m.to_str().unwrap().into(),
+            "--data".into(),
+            f.to_str().unwrap().into(),
+            "--horizons".into(),
+            h.into(),
+            "--json".into(),
+            d.join("c.json").to_str().unwrap().into(),
+        ]
+    };
+    let argv = args("5000");
+    let o = run(&argv.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("r.csv") && stderr(&o).contains("5000"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!d.join("c.json").exists());
+}
+
+/// Settings that cannot be honoured are bad input named before any work: a focus horizon
+/// longer than a quarter of a record, a hardware-in-the-loop run of no step, and a tuning
+/// record too short to score (found before the GA, not after it).
+#[test]
+fn settings_the_records_cannot_hold_are_refused_up_front() {
+    let d = scratch("settings");
+    let f = d.join("s.csv");
+    std::fs::write(&f, csv4(300, 1, 0.02)).unwrap();
+    let short = d.join("short.csv");
+    std::fs::write(&short, csv4(30, 2, 0.02)).unwrap();
+    let (fs, ss) = (f.to_str().unwrap(), short.to_str().unwrap());
+    let o = run(&["identify", "--data", fs, "--focus", "5000"]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("s.csv") && stderr(&o).contains("--focus 5000"));
+    let m = write_model(&d);
+    let o = run(&["hil", "--model", m.to_str().unwrap(), "--steps", "0"]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("--steps 0"), "{}", stderr(&o));
+    let o = run(&["tune", "--data", fs, "--validate", ss, "--seed", "1"]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("short.csv") && stderr(&o).contains("30 samples"));
+    // Refused on reading, before the starting model is identified.
+    assert!(!stderr(&o).contains("generation"), "{}", stderr(&o));
+}
+
+/// A `.json` model passes the checks a `.postcard` blob gets: huge coefficients and an
+/// unstable predictor are refused with the file named (exit 2), before any record is read.
+#[test]
+fn json_models_pass_the_checks_a_blob_gets() {
+    let d = scratch("jsonmodel");
+    let f = d.join("r.csv");
+    std::fs::write(&f, csv_text(200, 0.5)).unwrap();
+    for (name, text) in [
+        (
+            "huge.json",
+            r#"{"n":2,"ts":0.5,"a":[1e308,0.7],"b":[0.01,0.02],"k":[0.5,0.2],"effects":[]}"#,
+        ),
+        (
+            "unstable.json",
+            r#"{"n":2,"ts":0.5,"a":[0.0,1.3],"b":[0.01,0.02],"k":[0.0,0.0],"effects":[]}"#,
+        ),
+    ] {
+        let m = d.join(name);
+        std::fs::write(&m, text).unwrap();
+        let o = run(&[
+            "compare",
+            "--model",
+            m.to_str().unwrap(),
+            "--data",
+            f.to_str().unwrap(),
+        ]);
+        assert_eq!(code(&o), 2, "{name}: {}", stderr(&o));
+        assert!(stderr(&o).contains(name), "{name}: {}", stderr(&o));
+        assert!(stdout(&o).is_empty(), "{name}: {}", stdout(&o));
+    }
+}
+
+/// Bad navigation input names its file, row and column; a position jump of kilometres and a
+/// NaN fix are skipped and counted, never followed.
+#[test]
+fn navigation_input_errors_name_row_and_column_and_jumps_are_counted() {
+    let d = scratch("nav-input");
+    // a model with a heading/track part (no current), as identify writes it into the twin
+    let m = d.join("m.json");
+    std::fs::write(
+        &m,
+        r#"{"model":{"n":2,"ts":0.5,"a":[-0.2,0.7],"b":[0.01,0.02],"k":[0.5,0.2],"effects":[]},
+           "track":{"speed":1.0,"sway":0.0,"speed_loss":0.0,"current":false,"gain_speed":0.05,
+                    "gain_current":0.0,"gain_position":0.5,"fix_speed":0.02,"fix_current":0.0,
+                    "gate_velocity":3.0,"gate_position":200.0}}"#,
+    )
+    .unwrap();
+    let mut rows = String::from("t_s,delta_deg,r_degps,psi_deg,u_mps,cog_deg,north_m,east_m\n");
+    for (i, line) in csv_text(400, 0.5).lines().skip(1).enumerate() {
+        let n = 0.5 * i as f64;
+        let (north, east) = match i {
+            150 => ("5000".to_string(), "0".to_string()),
+            200 => ("NaN".to_string(), "0".to_string()),
+            _ => (format!("{n}"), "0".to_string()),
+        };
+        rows.push_str(&format!(
+            "{line},0,1.0,{},{north},{east}\n",
+            if i % 2 == 0 { 359.5 } else { 0.5 }
+        ));
+    }
+    std::fs::write(d.join("nav.csv"), &rows).unwrap();
+    let js = d.join("c.json");
+    let o = run(&[
+        "compare",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        d.join("nav.csv").to_str().unwrap(),
+        "--json",
+        js.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("2 navigation correction(s) skipped"),
+        "{}",
+        stderr(&o)
+    );
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&js).unwrap()).unwrap();
+    let r = &j["records"][0];
+    assert_eq!(r["nav_skipped"]["fix_gated"], 1);
+    assert_eq!(r["nav_skipped"]["fix_rejected"], 1);
+    assert_eq!(r["nav_skipped"]["velocity_gated"], 0);
+    // straight north at 1 m/s: the track prediction follows it (the jump is not followed)
+    let e30 = r["track_error_m"]["30"].as_f64().unwrap();
+    assert!(e30 < 1.0, "median 30-s track error {e30} m");
+    // (a constant heading has no spread to score a fit against, but the key is there)
+    assert!(r["heading_fit"].is_object());
+    // export carries the track part into a format 3 blob and the twin
+    let o = run(&[
+        "export",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        d.join("nav.csv").to_str().unwrap(),
+        "--out",
+        d.join("exp").to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let blob = std::fs::read(d.join("exp.postcard")).unwrap();
+    assert_eq!(&blob[4..6], &[3, 0]);
+    let twin: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("exp.json")).unwrap()).unwrap();
+    assert_eq!(twin["blob_format_version"], 3);
+    assert_eq!(twin["track"]["gate_position"], 200.0);
+    // bad cells: the error names file, row and column
+    for (name, header, cell, want) in [
+        (
+            "neg.csv",
+            "u_mps,cog_deg",
+            "-0.5,10",
+            "row 3, column `u_mps`: speed over ground -0.5 m/s is negative",
+        ),
+        (
+            "text.csv",
+            "u_mps,cog_deg",
+            "1.0,north",
+            "row 3, column `cog_deg`: expected a number (or an empty cell), found `north`",
+        ),
+        (
+            "lat.csv",
+            "lat_deg,lon_deg",
+            "95,10",
+            "row 3, column `lat_deg`: latitude 95 is outside ±90°",
+        ),
+        (
+            "half.csv",
+            "north_m",
+            "1",
+            "column `north_m` is there but `east_m` is not",
+        ),
+    ] {
+        let mut t = String::new();
+        for (i, line) in csv_text(300, 0.5).lines().enumerate() {
+            let extra = match i {
+                0 => header.to_string(),
+                3 => cell.to_string(),
+                _ => cell
+                    .replace("-0.5", "1.0")
+                    .replace("north", "10")
+                    .replace("95", "60"),
+            };
+            t.push_str(&format!("{line},{extra}\n"));
+        }
+        let p = d.join(name);
+        std::fs::write(&p, t).unwrap();
+        let o = run(&[
+            "compare",
+            "--model",
+            m.to_str().unwrap(),
+            "--data",
+            p.to_str().unwrap(),
+        ]);
+        assert_eq!(code(&o), 2, "{name}: {}", stderr(&o));
+        let first = stderr(&o).lines().next().unwrap_or_default().to_string();
+        assert!(
+            first.starts_with("error: ") && first.contains(name),
+            "{name}: {first}"
+        );
+        assert!(first.contains(want), "{name}: {first}");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
