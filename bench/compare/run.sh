@@ -45,7 +45,8 @@ for b in pem ga diagnose; do
 done
 
 echo "firmware: base $rev..." >&2
-(cd "$WT" && CARGO_TARGET_DIR=$OUT/target-base bash bench/firmware/run.sh >"$OUT/fw-base.md")
+# older revisions of the script build into ./target whatever CARGO_TARGET_DIR says
+(cd "$WT" && env -u CARGO_TARGET_DIR bash bench/firmware/run.sh >"$OUT/fw-base.md")
 echo "firmware: working tree..." >&2
 bash bench/firmware/run.sh >"$OUT/fw-head.md"
 
