@@ -297,6 +297,45 @@ impl<R> Effect<R> {
             Effect::DeadBand { .. } => EffectKind::DeadBand,
         }
     }
+
+    /// The same effect with every real parameter passed through `f` (the dead time's
+    /// samples and the damping's form unchanged): `f32` for the wire, `f64` for the host.
+    ///
+    /// ```
+    /// use yawcast_shared::model::Effect;
+    /// let e: Effect<f64> = Effect::Saturation { limit: 2.5f32 }.map(f64::from);
+    /// assert_eq!(e, Effect::Saturation { limit: 2.5 });
+    /// ```
+    pub fn map<S>(self, f: impl Fn(R) -> S) -> Effect<S> {
+        match self {
+            Effect::Bias { beta } => Effect::Bias { beta: f(beta) },
+            Effect::GyroBias { d_y } => Effect::GyroBias { d_y: f(d_y) },
+            Effect::DeadTime { samples } => Effect::DeadTime { samples },
+            Effect::RateLimit { rate } => Effect::RateLimit { rate: f(rate) },
+            Effect::Saturation { limit } => Effect::Saturation { limit: f(limit) },
+            Effect::Asymmetry { beta } => Effect::Asymmetry { beta: f(beta) },
+            Effect::NonlinearDamping { beta, cubic } => Effect::NonlinearDamping {
+                beta: f(beta),
+                cubic,
+            },
+            Effect::Wind {
+                beta_s2,
+                beta_c2,
+                beta_s1,
+                beta_c1,
+            } => Effect::Wind {
+                beta_s2: f(beta_s2),
+                beta_c2: f(beta_c2),
+                beta_s1: f(beta_s1),
+                beta_c1: f(beta_c1),
+            },
+            Effect::Current { beta_s, beta_c } => Effect::Current {
+                beta_s: f(beta_s),
+                beta_c: f(beta_c),
+            },
+            Effect::DeadBand { width } => Effect::DeadBand { width: f(width) },
+        }
+    }
 }
 
 /// One effect of every kind with typical parameters, in library order

@@ -135,27 +135,20 @@ pub(super) fn rank(
 /// none of the yaw-rate departures the other one explains, and a yaw-rate predictor is what
 /// the model is. The first such effect behind it moves ahead of it (`gains[i]`: held-out
 /// gain and fits of the significant effects, in the order of `ev`).
-pub(super) fn yaw_before_speed(
-    ev: &mut Vec<Evidence>,
-    gains: &mut Vec<Option<(f64, BTreeMap<String, f64>)>>,
-) {
-    let gain = |g: &Option<(f64, BTreeMap<String, f64>)>| g.as_ref().map(|g| g.0);
-    let material = |e: &Evidence, g: &Option<(f64, BTreeMap<String, f64>)>| {
-        g.is_some() && (e.channel_material || gain(g).is_some_and(|v| v > 0.0))
-    };
-    let Some(i) = (0..ev.len()).find(|&i| material(&ev[i], &gains[i])) else {
+pub(super) fn yaw_before_speed(ev: &mut Vec<Evidence>, gains: &mut Vec<HeldOut>) {
+    let Some(i) = first_material(ev, gains) else {
         return;
     };
-    let gi = gain(&gains[i]).unwrap_or(0.0);
+    let gi = gain_of(&gains[i]).unwrap_or(0.0);
     if !ev[i].speed_only || gi > 0.0 {
         return;
     }
-    let Some(j) =
-        (i + 1..ev.len()).find(|&j| !ev[j].speed_only && gain(&gains[j]).is_some_and(|v| v > 0.0))
+    let Some(j) = (i + 1..ev.len())
+        .find(|&j| !ev[j].speed_only && gain_of(&gains[j]).is_some_and(|v| v > 0.0))
     else {
         return;
     };
-    let gj = gain(&gains[j]).unwrap_or(0.0);
+    let gj = gain_of(&gains[j]).unwrap_or(0.0);
     let words = format!(
         "; named behind {}: only speed over ground shows it (the yaw channel shows no \
          heading-dependent moment) and it buys no held-out yaw-rate prediction ({gi:+.1} pp), \
@@ -163,7 +156,28 @@ pub(super) fn yaw_before_speed(
         ev[j].kind.name(),
         ev[j].kind.name(),
     );
-    ev[i].words.push_str(&words);
+    move_ahead(ev, gains, i, j, &words);
+}
+
+/// Held-out gain (pp) and fits of a significant effect; `None` for the others.
+pub(super) type HeldOut = Option<(f64, BTreeMap<String, f64>)>;
+
+fn gain_of(g: &HeldOut) -> Option<f64> {
+    g.as_ref().map(|g| g.0)
+}
+
+/// The first effect both significant and material (its channel shows it, or it improves
+/// held-out prediction), as [`ranked`] names it.
+fn first_material(ev: &[Evidence], gains: &[HeldOut]) -> Option<usize> {
+    (0..ev.len()).find(|&i| {
+        gains[i].is_some()
+            && (ev[i].channel_material || gain_of(&gains[i]).is_some_and(|v| v > 0.0))
+    })
+}
+
+/// Moves effect `j` (and its held-out figures) ahead of effect `i`, whose evidence says why.
+fn move_ahead(ev: &mut Vec<Evidence>, gains: &mut Vec<HeldOut>, i: usize, j: usize, why: &str) {
+    ev[i].words.push_str(why);
     let e = ev.remove(j);
     ev.insert(i, e);
     let g = gains.remove(j);
@@ -185,19 +199,15 @@ pub(super) const GAIN_PP: f64 = 1.0;
 /// passed over, if any.
 pub(super) fn gain_before_statistic(
     ev: &mut Vec<Evidence>,
-    gains: &mut Vec<Option<(f64, BTreeMap<String, f64>)>>,
+    gains: &mut Vec<HeldOut>,
 ) -> Option<EffectKind> {
-    let gain = |g: &Option<(f64, BTreeMap<String, f64>)>| g.as_ref().map(|g| g.0);
-    let material = |e: &Evidence, g: &Option<(f64, BTreeMap<String, f64>)>| {
-        g.is_some() && (e.channel_material || gain(g).is_some_and(|v| v > 0.0))
-    };
-    let i = (0..ev.len()).find(|&i| material(&ev[i], &gains[i]))?;
-    let gi = gain(&gains[i]).unwrap_or(0.0);
+    let i = first_material(ev, gains)?;
+    let gi = gain_of(&gains[i]).unwrap_or(0.0);
     if gi >= NO_GAIN_PP {
         return None;
     }
-    let j = (i + 1..ev.len()).find(|&j| gain(&gains[j]).is_some_and(|v| v >= GAIN_PP))?;
-    let gj = gain(&gains[j]).unwrap_or(0.0);
+    let j = (i + 1..ev.len()).find(|&j| gain_of(&gains[j]).is_some_and(|v| v >= GAIN_PP))?;
+    let gj = gain_of(&gains[j]).unwrap_or(0.0);
     let words = format!(
         "; named behind {} (a note, not the verdict): it improves held-out prediction by \
          {gi:+.1} pp, where {} is significant and improves it by {gj:+.1} pp — an effect \
@@ -206,12 +216,8 @@ pub(super) fn gain_before_statistic(
         ev[j].kind.name(),
         ev[j].kind.name(),
     );
-    ev[i].words.push_str(&words);
     let passed = ev[i].kind;
-    let e = ev.remove(j);
-    ev.insert(i, e);
-    let g = gains.remove(j);
-    gains.insert(i, g);
+    move_ahead(ev, gains, i, j, &words);
     Some(passed)
 }
 

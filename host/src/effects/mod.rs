@@ -306,40 +306,7 @@ impl Effect {
 
     /// The f32 schema's effect (parameters rounded to f32; a dead time capped at 255).
     pub fn to_spec(self) -> sm::Effect {
-        match self {
-            Effect::Bias { beta } => sm::Effect::Bias { beta: beta as f32 },
-            Effect::GyroBias { d_y } => sm::Effect::GyroBias { d_y: d_y as f32 },
-            Effect::DeadTime { samples } => sm::Effect::DeadTime {
-                samples: samples.min(255) as u8,
-            },
-            Effect::RateLimit { rate } => sm::Effect::RateLimit { rate: rate as f32 },
-            Effect::DeadBand { width } => sm::Effect::DeadBand {
-                width: width as f32,
-            },
-            Effect::Saturation { limit } => sm::Effect::Saturation {
-                limit: limit as f32,
-            },
-            Effect::Asymmetry { beta } => sm::Effect::Asymmetry { beta: beta as f32 },
-            Effect::NonlinearDamping { beta, cubic } => sm::Effect::NonlinearDamping {
-                beta: beta as f32,
-                cubic,
-            },
-            Effect::Wind {
-                beta_s2,
-                beta_c2,
-                beta_s1,
-                beta_c1,
-            } => sm::Effect::Wind {
-                beta_s2: beta_s2 as f32,
-                beta_c2: beta_c2 as f32,
-                beta_s1: beta_s1 as f32,
-                beta_c1: beta_c1 as f32,
-            },
-            Effect::Current { beta_s, beta_c } => sm::Effect::Current {
-                beta_s: beta_s as f32,
-                beta_c: beta_c as f32,
-            },
-        }
+        self.to_kernel().map(|x| x as f32)
     }
 
     /// The schema's effect with f64 parameters, as the shared kernel's `f64` instance runs
@@ -375,39 +342,31 @@ impl Effect {
 
     /// The f64 effect of an f32 schema effect (exact).
     pub fn from_spec(e: &sm::Effect) -> Effect {
-        match *e {
-            sm::Effect::Bias { beta } => Effect::Bias { beta: beta.into() },
-            sm::Effect::GyroBias { d_y } => Effect::GyroBias { d_y: d_y.into() },
+        match e.map(f64::from) {
+            sm::Effect::Bias { beta } => Effect::Bias { beta },
+            sm::Effect::GyroBias { d_y } => Effect::GyroBias { d_y },
             sm::Effect::DeadTime { samples } => Effect::DeadTime {
                 samples: samples.into(),
             },
-            sm::Effect::RateLimit { rate } => Effect::RateLimit { rate: rate.into() },
-            sm::Effect::DeadBand { width } => Effect::DeadBand {
-                width: width.into(),
-            },
-            sm::Effect::Saturation { limit } => Effect::Saturation {
-                limit: limit.into(),
-            },
-            sm::Effect::Asymmetry { beta } => Effect::Asymmetry { beta: beta.into() },
-            sm::Effect::NonlinearDamping { beta, cubic } => Effect::NonlinearDamping {
-                beta: beta.into(),
-                cubic,
-            },
+            sm::Effect::RateLimit { rate } => Effect::RateLimit { rate },
+            sm::Effect::DeadBand { width } => Effect::DeadBand { width },
+            sm::Effect::Saturation { limit } => Effect::Saturation { limit },
+            sm::Effect::Asymmetry { beta } => Effect::Asymmetry { beta },
+            sm::Effect::NonlinearDamping { beta, cubic } => {
+                Effect::NonlinearDamping { beta, cubic }
+            }
             sm::Effect::Wind {
                 beta_s2,
                 beta_c2,
                 beta_s1,
                 beta_c1,
             } => Effect::Wind {
-                beta_s2: beta_s2.into(),
-                beta_c2: beta_c2.into(),
-                beta_s1: beta_s1.into(),
-                beta_c1: beta_c1.into(),
+                beta_s2,
+                beta_c2,
+                beta_s1,
+                beta_c1,
             },
-            sm::Effect::Current { beta_s, beta_c } => Effect::Current {
-                beta_s: beta_s.into(),
-                beta_c: beta_c.into(),
-            },
+            sm::Effect::Current { beta_s, beta_c } => Effect::Current { beta_s, beta_c },
         }
     }
 

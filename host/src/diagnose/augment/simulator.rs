@@ -225,11 +225,6 @@ pub(super) fn reference_harmonics(
     let g = ata.cholesky()?.solve(&atb);
     let mut e = Effect::zero(kind, 0.0);
     e.set_gains(g.as_slice());
-    harmonics(&e)
-}
-
-/// (β_s2, β_c2, β_s1, β_c1) of a wind or current effect.
-fn harmonics(e: &Effect) -> Option<[f64; 4]> {
     e.harmonics()
 }
 
@@ -273,7 +268,7 @@ fn match_rotation(target: &[f64; 4], reference: &[f64; 4]) -> (f64, f64) {
 /// rotated to match the model's best; the speed with the smallest mismatch is refined by
 /// golden-section search (in log speed) and its rotation is the direction.
 fn heading_effect(effect: &Effect, model: &Model, ship: &Ship) -> Option<SimEffect> {
-    let target = harmonics(effect)?;
+    let target = effect.harmonics()?;
     let wind = matches!(effect, Effect::Wind { .. });
     let make = |speed: f64, dir: f64| {
         if wind {
