@@ -411,8 +411,7 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
     } else {
         (None, read_track(&args.model, &given)?)
     };
-    let ex =
-        super::pipeline::add_model_with_track(&mut outputs, written, track_part, &args.out, check)?;
+    let ex = super::pipeline::add_model(&mut outputs, written, track_part, &args.out, check)?;
     let mut done = vec![format!(
         "model written to {} and {}{}",
         ex.blob_path.display(),
@@ -536,7 +535,7 @@ fn write_unchanged(
         .context("no record to check the export on")?;
     // the model's heading/track part goes with it unchanged
     let track = read_track(&args.model, given)?;
-    let ex = super::pipeline::add_model_with_track(&mut outputs, written, track, &args.out, check)?;
+    let ex = super::pipeline::add_model(&mut outputs, written, track, &args.out, check)?;
     let mut done = vec![if what == Written::Input {
         format!(
             "no effect to add: the input model is written unchanged to {}",

@@ -32,20 +32,10 @@ fn names(paths: &[PathBuf]) -> String {
         .join(", ")
 }
 
-/// Adds `model` as `<out>.postcard` + `<out>.json` to `outputs`, checked through the firmware
-/// on `check` (also `augment`'s).
+/// Adds `model` with its heading/track part (when it has one: a format 3 blob and the twin's
+/// `track`) as `<out>.postcard` + `<out>.json` to `outputs`, checked through the firmware on
+/// `check` (also `augment`'s).
 pub(super) fn add_model(
-    outputs: &mut Outputs,
-    model: &Model,
-    out: &Path,
-    check: &Record,
-) -> Result<export::ExportReport> {
-    add_model_with_track(outputs, model, None, out, check)
-}
-
-/// [`add_model`] with the model's heading/track part (written into a format 3 blob and the
-/// twin's `track`).
-pub(super) fn add_model_with_track(
     outputs: &mut Outputs,
     model: &Model,
     track: Option<yawcast_shared::nav::TrackSpec>,
@@ -412,7 +402,7 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
     if let Some(out) = &args.out {
         let check = val.first().unwrap_or(&recs[0]);
         let track = track_from_records(&args.read, &model, &recs, &args.data, false)?;
-        let r = add_model_with_track(&mut outputs, &model, track, out, check)?;
+        let r = add_model(&mut outputs, &model, track, out, check)?;
         done = Some(format!(
             "model written to {} and {}",
             r.blob_path.display(),
@@ -660,7 +650,10 @@ pub fn tune(args: &TuneArgs) -> Result<()> {
     }
     let mut done = Vec::new();
     if let Some(out) = &args.out {
-        let r = add_model(&mut outputs, &rep.best_model, out, &trials[0])?;
+        // the ship's heading/track part, from the trials (the ship's own records)
+        let track =
+            track_from_records(&args.read, &rep.best_model, &trials, &args.validate, false)?;
+        let r = add_model(&mut outputs, &rep.best_model, track, out, &trials[0])?;
         let which = match &rep.gain {
             Some(g) if !g.tuned_kept => "conventional",
             _ => "tuned",
@@ -795,7 +788,8 @@ pub fn average(args: &AverageArgs) -> Result<()> {
                 args.method
             )
         })?;
-        let r = add_model(&mut outputs, &c.model, out, &val[0])?;
+        let track = track_from_records(&args.read, &c.model, &recs, &args.data, false)?;
+        let r = add_model(&mut outputs, &c.model, track, out, &val[0])?;
         done = Some(format!(
             "model written to {} and {}",
             r.blob_path.display(),

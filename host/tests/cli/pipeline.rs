@@ -699,3 +699,68 @@ fn resid_reports_whiteness_and_writes_all_outputs_or_none() {
         .unwrap_or_default();
     assert!(left.is_empty(), "{left:?}");
 }
+
+#[test]
+fn tune_and_average_write_the_heading_track_part_of_their_records() {
+    let d = scratch("track-parts");
+    let o = run(&[
+        "simulate",
+        "--seed",
+        "21",
+        "--duration",
+        "600",
+        "--records",
+        "3",
+        "--out",
+        d.join("r.csv").to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let p = |f: &str| d.join(f).to_str().unwrap().to_string();
+    let twin = |f: &str| -> serde_json::Value {
+        serde_json::from_slice(&std::fs::read(d.join(f)).unwrap()).unwrap()
+    };
+    // the track part is fitted on the ship's records alone, so each command's equals
+    // identify's on the same records
+    let track_of = |data: &[&str], out: &str| {
+        let mut a = vec!["identify".to_string()];
+        for f in data {
+            a.extend(["--data".to_string(), p(f)]);
+        }
+        a.extend(["--out".to_string(), p(out)]);
+        let o = bin().args(&a).output().unwrap();
+        assert_eq!(code(&o), 0, "{}", stderr(&o));
+        twin(&format!("{out}.json"))["track"].clone()
+    };
+    let o = run(&[
+        "average",
+        "--data",
+        &p("r-1.csv"),
+        "--data",
+        &p("r-2.csv"),
+        "--validate",
+        &p("r-3.csv"),
+        "--out",
+        &p("avg"),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let avg = twin("avg.json")["track"].clone();
+    assert!(avg["speed"].as_f64().unwrap() > 1.0, "{avg}");
+    assert_eq!(avg, track_of(&["r-1.csv", "r-2.csv"], "id12"));
+    let o = run(&[
+        "tune",
+        "--data",
+        &p("r-1.csv"),
+        "--validate",
+        &p("r-3.csv"),
+        "--generations",
+        "2",
+        "--seed",
+        "5",
+        "--out",
+        &p("tuned"),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let tuned = twin("tuned.json")["track"].clone();
+    assert_eq!(tuned, track_of(&["r-3.csv"], "id3"));
+    assert_ne!(tuned, avg);
+}
