@@ -201,6 +201,33 @@ fn beta_cf(x: f64, a: f64, b: f64) -> f64 {
     h
 }
 
+/// F-distribution upper-tail probability P(F > f) with `d1` and `d2` degrees of freedom
+/// (`d1, d2 > 0`): `I_{d2/(d2 + d1·f)}(d2/2, d1/2)`; `d2 = ∞` gives the χ² limit
+/// `P(χ²_{d1} > d1·f)`.
+///
+/// ```
+/// use yawcast::stats::{chi2_sf, f_sf};
+/// // F(2, 2): P(F > f) = 1/(1 + f)
+/// assert!((f_sf(3.0, 2.0, 2.0) - 0.25).abs() < 1e-13);
+/// assert_eq!(f_sf(2.5, 4.0, f64::INFINITY), chi2_sf(10.0, 4.0));
+/// assert_eq!(f_sf(0.0, 2.0, 6.0), 1.0);
+/// ```
+pub fn f_sf(f: f64, d1: f64, d2: f64) -> f64 {
+    if f.is_nan() || !(d1 > 0.0 && d2 > 0.0) {
+        return f64::NAN;
+    }
+    if f <= 0.0 {
+        return 1.0;
+    }
+    if d2.is_infinite() {
+        return chi2_sf(d1 * f, d1);
+    }
+    if f.is_infinite() {
+        return 0.0;
+    }
+    beta_reg(d2 / (d2 + d1 * f), 0.5 * d2, 0.5 * d1)
+}
+
 /// Student t upper-tail probability P(T > t) with `dof` degrees of freedom (`dof > 0`).
 ///
 /// ```

@@ -11,7 +11,7 @@ use super::verdict::{cfg_m, Evidence};
 use super::{heading_bias, DiagnoseConfig};
 use crate::effects::{def, Channel};
 use crate::io::data::Record;
-use crate::stats::{chi2_sf, normal_sf};
+use crate::stats::{f_sf, normal_sf};
 
 /// What heading and speed over ground show on the trials against the reference: whether
 /// every record logs them, the gyro offset the heading shows (trial minus reference when
@@ -69,7 +69,7 @@ impl Channels {
 /// intercept per record and r² and δ² low-passed through each time constant of
 /// [`sog_taus`] (speed lost in turns and to rudder/pod drag, whatever the ship's surge time
 /// constant). `shift[i]` circularly shifts record i's heading against its speed (0: aligned).
-fn sog_harmonics(recs: &[Record], shift: &[usize], taus: &[f64]) -> Option<DVector<f64>> {
+fn sog_harmonics(recs: &[&Record], shift: &[usize], taus: &[f64]) -> Option<DVector<f64>> {
     let nr = recs.len();
     let nt = taus.len();
     let p = nr + 4 + 2 * nt;
@@ -115,12 +115,15 @@ fn sog_harmonics(recs: &[Record], shift: &[usize], taus: &[f64]) -> Option<DVect
 /// Time constants (s) of the low-pass nuisance regressors of speed over ground: a surge
 /// equation `(m − X_u̇) u̇ = X(u) + X_rr r² + X_δδ δ² + …` makes the speed lost in turns a
 /// first-order lag of r² and δ² with the surge time constant `T_u = (m − X_u̇)/(−∂X/∂u)`,
-/// which is not known here and spans ≈ 10 s on a model ship to minutes on a large one. A
-/// first-order lag anywhere in 10–270 s is matched closely by a combination of its two
-/// neighbours in this bank (ratio 3); with one fixed time constant the unmatched part of the
-/// speed loss follows the turning history, and with it the heading, and passes for a
-/// current. Time constants longer than a quarter of the shortest record are dropped (the
-/// per-record intercept already takes what they would).
+/// which is not known here and spans ≈ 10 s on a model ship to ≈ 15 minutes on a
+/// full-scale tanker (KVLCC2 at 15.5 kn: `m ≈ 3.3·10⁵ t`, `−∂X/∂u ≈ 2R/U ≈ 4·10⁵ N·s/m`,
+/// `T_u ≈ 850 s`). A first-order lag anywhere in 10–810 s is matched closely by a combination
+/// of its two neighbours in this bank (ratio 3); with one fixed time constant, or a bank that
+/// stops short of the hull's, the unmatched part of the speed loss — on a full-scale hull
+/// the slow fall from the approach speed over the first turns — follows the turning history,
+/// and with it the heading, and passes for a current. Time constants longer than half the
+/// shortest record are dropped (over so short a record the per-record intercept and the
+/// shorter lags take what they would).
 pub(super) fn sog_taus<'a>(recs: impl Iterator<Item = &'a Record>) -> Vec<f64> {
     let shortest = recs
         .map(|r| r.len() as f64 * r.ts)
@@ -128,7 +131,7 @@ pub(super) fn sog_taus<'a>(recs: impl Iterator<Item = &'a Record>) -> Vec<f64> {
     let mut out: Vec<f64> = SOG_TAUS_S
         .iter()
         .copied()
-        .filter(|tau| *tau <= 0.25 * shortest)
+        .filter(|tau| *tau <= 0.5 * shortest)
         .collect();
     if out.is_empty() {
         out.push(SOG_TAUS_S[0]);
@@ -137,14 +140,14 @@ pub(super) fn sog_taus<'a>(recs: impl Iterator<Item = &'a Record>) -> Vec<f64> {
 }
 
 /// The bank of surge time constants (s) of [`sog_taus`].
-const SOG_TAUS_S: [f64; 4] = [10.0, 30.0, 90.0, 270.0];
+const SOG_TAUS_S: [f64; 5] = [10.0, 30.0, 90.0, 270.0, 810.0];
 /// Circular shifts drawn for the null covariance of the speed harmonics.
 const SOG_SHIFTS: usize = 60;
 
 /// Covariance of the harmonics under "no heading dependence": heading circularly shifted
 /// against speed by random amounts (10–90 % of each record), which keeps both series'
 /// own structure.
-fn sog_null_cov(recs: &[Record], taus: &[f64], rng: &mut ChaCha8Rng) -> Option<DMatrix<f64>> {
+fn sog_null_cov(recs: &[&Record], taus: &[f64], rng: &mut ChaCha8Rng) -> Option<DMatrix<f64>> {
     let mut draws = Vec::with_capacity(SOG_SHIFTS);
     for _ in 0..SOG_SHIFTS {
         let sh: Vec<usize> = recs
@@ -177,15 +180,92 @@ fn wald(d: &DVector<f64>, v: &DMatrix<f64>, idx: &[usize]) -> f64 {
     }
 }
 
-/// SOG evidence: (χ² first harmonic, χ² second harmonic, first-harmonic amplitude m/s,
-/// direction deg the speed gain points to).
+/// SOG evidence: the Wald χ² of the first and second harmonics (trial minus reference),
+/// calibrated for the aliasing the records show without any current, the first-harmonic
+/// amplitude (m/s) and the direction (deg) the speed gain points to.
+///
+/// The circular-shift null knows the noise of each series but not the speed lost in turns
+/// that the surge lags leave: on a full-scale hull turning through part of a circle that
+/// remainder follows the heading, and passes for a current. How much it does is measured on
+/// the records themselves: each record against the others of its own set (reference, and
+/// trials — a current common to the trials cancels there), the same statistic. `inflation`
+/// is their mean χ² per degree of freedom (at least 1) and divides the χ²; the p-value is
+/// then an F with the splits' degrees of freedom.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct SogEvidence {
+    /// χ² of the first harmonic (2 df), divided by `inflation[0]`.
     pub(super) chi1: f64,
+    /// χ² of the second harmonic (2 df), divided by `inflation[1]`.
     pub(super) chi2: f64,
+    /// The χ² before calibration (first, second harmonic).
+    pub(super) raw: [f64; 2],
+    /// Aliasing inflation of each harmonic's χ² (≥ 1).
+    pub(super) inflation: [f64; 2],
+    /// Degrees of freedom of the inflation estimate per harmonic (2 per split; ∞ when the
+    /// inflation is 1: the χ² is then used as it is).
+    pub(super) inflation_df: [f64; 2],
     pub(super) amp1: f64,
     pub(super) dir1: f64,
     pub(super) amp2: f64,
+    /// Largest variance (m/s)² of the first harmonic in any direction (the circular-shift
+    /// null's, times the inflation): what the records can resolve.
+    pub(super) var1: f64,
+}
+
+impl SogEvidence {
+    /// `(χ², df, p)` of what speed over ground shows: the first harmonic for a current, both
+    /// for wind.
+    pub(super) fn test(&self, current: bool) -> (f64, f64, f64) {
+        if current {
+            let p = f_sf(self.chi1 / 2.0, 2.0, self.inflation_df[0]);
+            (self.chi1, 2.0, p)
+        } else {
+            let chi = self.chi1 + self.chi2;
+            let d2 = self.inflation_df[0].min(self.inflation_df[1]) * 2.0;
+            (chi, 4.0, f_sf(chi / 4.0, 4.0, d2))
+        }
+    }
+
+    /// The smallest current (m/s) speed over ground shows at the level `level` whatever its
+    /// direction: the amplitude whose χ² (along the direction the records resolve worst)
+    /// reaches the level's critical value.
+    pub(super) fn smallest_current(&self, level: f64) -> f64 {
+        // the critical F (2, inflation_df) by bisection on its tail
+        let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+        while f_sf(hi, 2.0, self.inflation_df[0]) > level && hi < 1e12 {
+            hi *= 2.0;
+        }
+        for _ in 0..100 {
+            let mid = 0.5 * (lo + hi);
+            if f_sf(mid, 2.0, self.inflation_df[0]) > level {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        // χ²/inflation = a²/var1 = 2·F
+        (2.0 * hi * self.var1).sqrt()
+    }
+
+    /// The calibration in words, empty when the records show no aliasing.
+    fn calibration_words(&self, current: bool) -> String {
+        let (phi, raw) = if current {
+            (self.inflation[0], self.raw[0])
+        } else {
+            (
+                0.5 * (self.inflation[0] + self.inflation[1]),
+                self.raw[0] + self.raw[1],
+            )
+        };
+        if phi <= 1.0 {
+            return String::new();
+        }
+        format!(
+            "; χ² {raw:.1} divided by {phi:.1}: the records vary with heading by as much \
+             against each other without a current (speed lost in turns), so speed over ground \
+             tells a current only beyond that"
+        )
+    }
 }
 
 pub(super) fn sog_evidence(
@@ -201,6 +281,24 @@ pub(super) fn sog_evidence(
     )
 }
 
+/// Harmonics of `trial` minus those of `reference` (none when empty) with the circular-shift
+/// covariance of the difference.
+fn sog_difference(
+    trial: &[&Record],
+    reference: &[&Record],
+    taus: &[f64],
+    rng: &mut ChaCha8Rng,
+) -> Option<(DVector<f64>, DMatrix<f64>)> {
+    let t = sog_harmonics(trial, &[], taus)?;
+    let vt = sog_null_cov(trial, taus, rng)?;
+    if reference.is_empty() {
+        return Some((t, vt));
+    }
+    let r = sog_harmonics(reference, &[], taus)?;
+    let vr = sog_null_cov(reference, taus, rng)?;
+    Some((t - r, vt + vr))
+}
+
 /// [`sog_evidence`] with the nuisance time constants given.
 pub(super) fn sog_evidence_with(
     trial: &[Record],
@@ -209,22 +307,53 @@ pub(super) fn sog_evidence_with(
     taus: &[f64],
 ) -> Option<SogEvidence> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5047_5f53_4f47);
-    let t = sog_harmonics(trial, &[], taus)?;
-    let vt = sog_null_cov(trial, taus, &mut rng)?;
-    let (d, v) = if reference.is_empty() {
-        (t, vt)
-    } else {
-        let r = sog_harmonics(reference, &[], taus)?;
-        let vr = sog_null_cov(reference, taus, &mut rng)?;
-        (t - r, vt + vr)
-    };
+    let trial: Vec<&Record> = trial.iter().collect();
+    let reference: Vec<&Record> = reference.iter().collect();
+    let (d, v) = sog_difference(&trial, &reference, taus, &mut rng)?;
+    // each record against the others of its set: the aliasing without a current
+    let mut sums = [0.0; 2];
+    let mut splits = 0usize;
+    for set in [&reference, &trial] {
+        if set.len() < 2 {
+            continue;
+        }
+        for j in 0..set.len() {
+            let rest: Vec<&Record> = (0..set.len()).filter(|&i| i != j).map(|i| set[i]).collect();
+            if let Some((dj, vj)) = sog_difference(&set[j..=j], &rest, taus, &mut rng) {
+                sums[0] += wald(&dj, &vj, &[0, 1]);
+                sums[1] += wald(&dj, &vj, &[2, 3]);
+                splits += 1;
+            }
+        }
+    }
+    let raw = [wald(&d, &v, &[0, 1]), wald(&d, &v, &[2, 3])];
+    let mut inflation = [1.0; 2];
+    let mut inflation_df = [f64::INFINITY; 2];
+    for k in 0..2 {
+        if splits > 0 {
+            let phi = sums[k] / (2.0 * splits as f64);
+            if phi > 1.0 {
+                inflation[k] = phi;
+                inflation_df[k] = 2.0 * splits as f64;
+            }
+        }
+    }
     Some(SogEvidence {
-        chi1: wald(&d, &v, &[0, 1]),
-        chi2: wald(&d, &v, &[2, 3]),
+        chi1: raw[0] / inflation[0],
+        chi2: raw[1] / inflation[1],
+        raw,
+        inflation,
+        inflation_df,
         amp1: d[0].hypot(d[1]),
         dir1: d[0].atan2(d[1]).to_degrees().rem_euclid(360.0),
         amp2: d[2].hypot(d[3]),
+        var1: inflation[0] * largest_eigenvalue(v[(0, 0)], v[(0, 1)], v[(1, 1)]),
     })
+}
+
+/// Largest eigenvalue of the symmetric 2×2 matrix `[[a, b], [b, c]]`.
+fn largest_eigenvalue(a: f64, b: f64, c: f64) -> f64 {
+    0.5 * (a + c) + (0.25 * (a - c) * (a - c) + b * b).sqrt()
 }
 
 /// What the heading and speed-over-ground channels add to the evidence of `ev.kind`: a gyro
@@ -261,12 +390,9 @@ pub(super) fn add_channels(
         }
         Channel::SpeedOverGround => {
             if let Some(s) = sog {
-                let (chi, df) = if kind == EffectKind::Current {
-                    (s.chi1, 2.0)
-                } else {
-                    (s.chi1 + s.chi2, 4.0)
-                };
-                let p_sog = chi2_sf(chi, df);
+                let current = kind == EffectKind::Current;
+                let (chi, df, p_sog) = s.test(current);
+                let calibration = s.calibration_words(current);
                 // either channel may show it (Bonferroni over the two)
                 ev.p = (2.0 * p_yaw.min(p_sog)).min(1.0);
                 ev.score = ev.score.max(chi - df);
@@ -275,13 +401,13 @@ pub(super) fn add_channels(
                     ev.parameter = Some(s.amp1);
                     ev.words.push_str(&format!(
                         "; speed over ground varies by ±{:.3} m/s with heading, fastest heading \
-                         {:.0}° (χ² = {chi:.1}, 2 df)",
+                         {:.0}° (χ² = {chi:.1}, 2 df{calibration})",
                         s.amp1, s.dir1
                     ));
                 } else {
                     ev.words.push_str(&format!(
                         "; speed over ground varies with heading by ±{:.3} m/s (1st harmonic) and \
-                         ±{:.3} m/s (2nd) (χ² = {chi:.1}, 4 df)",
+                         ±{:.3} m/s (2nd) (χ² = {chi:.1}, 4 df{calibration})",
                         s.amp1, s.amp2
                     ));
                 }

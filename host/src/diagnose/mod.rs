@@ -430,6 +430,14 @@ pub fn diagnose(
         foreign_pct,
         &ch,
     );
+    if let Some(s) = ch
+        .sog
+        .filter(|_| verdict_name != EffectKind::Current.name())
+    {
+        caveats.push(Caveat::CurrentResolution {
+            smallest_mps: s.smallest_current(level),
+        });
+    }
     if let Some(k) = passed_over.filter(|k| k.name() != verdict_name) {
         caveats.push(Caveat::PassedOver {
             effect: k.name().into(),

@@ -418,24 +418,36 @@ pub(crate) fn slow_gear_records(kind: Option<EffectKind>, seeds: &[u64]) -> Vec<
 fn speed_lost_in_turns_is_not_a_current() {
     // a dead time changes the turning history, and with it the heading history, against
     // the reference's: with one 20 s lag the speed lost in turns that the nuisance
-    // regressors leave aliases onto the heading harmonics and passes for a current
-    // (p < 1e-3 at 2 df, significant at α/9); the bank of surge lags takes it out
+    // regressors leave aliases onto the heading harmonics and would pass for a current
+    // (p < 1e-3 at 2 df, significant at α/9); the records against each other show that
+    // aliasing, and the calibrated test no longer takes it for one; the bank of surge lags
+    // takes it out
+    let level = 0.01 / 9.0;
     let reference = records(None, &[300, 301]);
     let trial = records(Some((EffectKind::DeadTime, 1.0)), &[302, 303]);
     let one = sog_evidence_with(&trial, &reference, 1, &[20.0]).unwrap();
-    assert!(one.chi1 > 13.8 && one.amp1 > 0.02, "{one:?}");
+    assert!(one.raw[0] > 13.8 && one.amp1 > 0.02, "{one:?}");
+    assert!(one.inflation[0] > 1.2, "{one:?}");
+    assert!(one.test(true).2 > level, "{one:?}");
     let bank = sog_evidence(&trial, &reference, 1).unwrap();
     assert!(bank.chi1 < 9.21 && bank.amp1 < 0.01, "{bank:?}");
+    assert!(bank.test(true).2 > level, "{bank:?}");
     // no hidden effect at all: the same
     let none = records(None, &[302, 303]);
     let one = sog_evidence_with(&none, &reference, 1, &[20.0]).unwrap();
-    assert!(one.chi1 > 13.8, "{one:?}");
+    assert!(one.raw[0] > 13.8, "{one:?}");
+    assert!(one.test(true).2 > level, "{one:?}");
     let bank = sog_evidence(&none, &reference, 1).unwrap();
     assert!(bank.chi1 < 9.21 && bank.amp1 < 0.01, "{bank:?}");
+    // a current of 0.05 m/s stays plain on these records, and they say so
+    assert!(bank.smallest_current(level) < 0.05, "{bank:?}");
     assert_eq!(
         sog_taus(reference.iter().chain(&trial)),
-        vec![10.0, 30.0, 90.0, 270.0]
+        vec![10.0, 30.0, 90.0, 270.0, 810.0]
     );
+    // up to half the shortest record (a full-scale tanker's surge lag is ≈ 800 s)
+    let short: Vec<Record> = trial.iter().map(|r| r.slice(0, 1000)).collect();
+    assert_eq!(sog_taus(short.iter()), vec![10.0, 30.0, 90.0, 270.0]);
 }
 
 #[test]

@@ -563,6 +563,14 @@ pub enum Caveat {
     NoHeading,
     /// Speed over ground (or heading) is not logged in every record.
     NoSpeedOverGround,
+    /// Speed over ground cannot show a current weaker than `smallest_mps` on these records
+    /// (heading range, speed lost in turns): a verdict other than current does not rule
+    /// one out.
+    CurrentResolution {
+        /// The smallest current (m/s) the records show at the level applied, in any
+        /// direction.
+        smallest_mps: f64,
+    },
     /// A significant effect that does not improve held-out prediction was named behind
     /// the verdict by the ranking rule.
     PassedOver {
@@ -611,6 +619,11 @@ impl Caveat {
                 record: current and wind are judged from the yaw rate alone and are hard to tell \
                 apart from a bias."
                 .into(),
+            Caveat::CurrentResolution { smallest_mps } => format!(
+                "Speed over ground on these records shows a current only from about \
+                 {smallest_mps:.2} m/s on (in any direction, at the level applied: the headings \
+                 sailed and the speed lost in turns limit it); a weaker current cannot be told."
+            ),
             Caveat::PassedOver { effect } => {
                 let kind = EffectKind::from_name(effect);
                 format!(

@@ -69,8 +69,13 @@ fn diagnose_names_a_hidden_dead_time_and_writes_stable_json() {
     assert_eq!(v["verdict"], "dead-time");
     assert_eq!(v["seed"], 5);
     assert_eq!(v["reference_used"], true);
-    // references given, heading and speed logged, short records: nothing qualifies it
-    assert_eq!(v["caveats"], serde_json::json!([]), "{}", v["explanation"]);
+    // references given, heading and speed logged, short records: nothing qualifies it but
+    // the smallest current speed over ground would show (a few cm/s on this ship's records)
+    let caveats = v["caveats"].as_array().unwrap();
+    assert_eq!(caveats.len(), 1, "{}", v["explanation"]);
+    assert_eq!(caveats[0]["caveat"], "current-resolution");
+    let smallest = caveats[0]["smallest_mps"].as_f64().unwrap();
+    assert!(smallest > 0.001 && smallest < 0.1, "{smallest}");
     assert_eq!(v["ranking"][0]["effect"], "dead-time");
     assert!(v["ranking"][0]["p_value"].as_f64().unwrap() < 1e-3);
     assert!(v["ranking"][0]["statistic"].as_f64().unwrap() > 0.0);
