@@ -68,7 +68,10 @@
 //!   a yaw moment at level α names wind, none names current.
 //!
 //! Effects already in the model are skipped, so diagnosing an augmented model looks for the
-//! next one.
+//! next one — but for a steady offset (`bias`, `gyro-bias`) the model carries as the
+//! reference's own (identification adds one where the reference needs it; the model is not
+//! [foreign](Caveat::ForeignModel) to the reference): that one is tested for a *change* on
+//! the trials, the reference's version (the model's own) against the trials' best.
 
 pub mod augment;
 mod channels;
@@ -92,6 +95,7 @@ use crate::diagnose::augment::{AugmentConfig, AugmentReport};
 use crate::diagnose::compare::{check_inputs, mean_fit, InputError};
 use crate::effects::GridSpan;
 use crate::identify::model::{Effect, Model};
+use crate::identify::pem::offset::OFFSET_KINDS;
 use crate::identify::predict::Horizon;
 use crate::io::data::Record;
 use channels::Channels;
@@ -335,10 +339,13 @@ pub fn diagnose(
         sigma
     };
 
+    // an offset the model carries as the reference's own (identified on it) is tested for a
+    // change on the trials; any other effect already in the model is skipped
+    let own_offsets = has_ref && foreign_pct.is_none();
     let kinds: Vec<EffectKind> = EffectKind::ALL
         .iter()
         .copied()
-        .filter(|k| model.effect(*k).is_none())
+        .filter(|k| model.effect(*k).is_none() || (own_offsets && OFFSET_KINDS.contains(k)))
         .filter(|k| !(*k == EffectKind::Saturation && u_max <= 0.0))
         .collect();
 

@@ -563,3 +563,24 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
         assert_eq!(ev[1].p, p);
     }
 }
+
+#[test]
+fn a_steady_moment_the_reference_carries_is_tested_for_a_change() {
+    // the reference has a steady yaw moment of its own (as a single-screw hull has), which
+    // identification puts into the model as `bias`; trials with a larger one are a change
+    // the model's own cannot explain, trials with the same one are not
+    let refs = records(Some((EffectKind::Bias, 1.0)), &[950, 951, 952]);
+    let (rep, choice) = pem::offset::identify(&refs, &PemConfig::default()).unwrap();
+    assert!(rep.model.effect(EffectKind::Bias).is_some(), "{choice:?}");
+    let cfg = DiagnoseConfig {
+        seed: 3,
+        ..DiagnoseConfig::default()
+    };
+    let more = records(Some((EffectKind::Bias, 2.5)), &[960, 961, 962]);
+    let d = diagnose(&rep.model, &refs, &more, &[], &cfg).unwrap();
+    assert_eq!(d.verdict, "bias", "{}", d.explanation);
+    assert_ranking_rule(&d);
+    let same = records(Some((EffectKind::Bias, 1.0)), &[970, 971, 972]);
+    let d = diagnose(&rep.model, &refs, &same, &[], &cfg).unwrap();
+    assert_eq!(d.verdict, "none", "{}", d.explanation);
+}

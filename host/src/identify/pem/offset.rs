@@ -122,6 +122,11 @@ fn settles(model: &Model, recs: &[Record]) -> bool {
     len * ra.max(rp).ln() <= 0.01f64.ln()
 }
 
+/// The steady offsets identification fits to a record set by itself when its errors ask
+/// for one: a steady yaw moment (`bias`) or a rate-gyro offset (`gyro-bias`). A model
+/// identified on a reference may carry either as the reference's own.
+pub const OFFSET_KINDS: [EffectKind; 2] = [EffectKind::Bias, EffectKind::GyroBias];
+
 /// [`super::identify`] of the plain structure, with an offset effect added when the plain
 /// model needs an integrator to carry one or the heading shows a gyro offset (module docs). The effect's gain is estimated
 /// with θ; the returned choice is `None` when the plain model stands.
@@ -153,7 +158,7 @@ pub fn identify(
     // offset the heading shows, for that one
     let integrator = !settles(&plain.model, records);
     let kinds: &[EffectKind] = if integrator || off_centre(&plain, records) {
-        &[EffectKind::Bias, EffectKind::GyroBias]
+        &OFFSET_KINDS
     } else if gyro_seen {
         &[EffectKind::GyroBias]
     } else {
