@@ -10,7 +10,9 @@
 #   --worlds LIST     comma-separated worlds (default lng,kvlcc2,mariner)
 #   --seeds N         seeds per case (default 3)
 #   --strengths LIST  comma-separated effect strengths (default 1,0.5)
-#   --effects LIST    comma-separated effects (default: none and every library effect)
+#   --effects LIST    comma-separated effects (default: none and every library effect); a
+#                     two-effect case is written a+b (e.g. rate-limit+wind): it is right when
+#                     both are among the first two significant effects of the ranking
 #   --jobs J          cases run at once (default 2)
 #
 # Per world: the reference is 3 records of the world's identification input (seeds 900–902,
@@ -39,7 +41,7 @@ while [ $# -gt 0 ]; do
         --strengths) strengths="$2"; shift 2 ;;
         --effects) effects="$2"; shift 2 ;;
         --jobs) jobs="$2"; shift 2 ;;
-        -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
+        -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
         *) echo "unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
@@ -56,7 +58,11 @@ case_run() {
     local dir="$WORK/$world/$effect-$strength-$seed"
     mkdir -p "$dir"
     local eff=()
-    [ "$effect" != none ] && eff=(--effect "$effect" --strength "$strength")
+    if [ "$effect" != none ]; then
+        IFS=+ read -r -a parts <<<"$effect"
+        for p in "${parts[@]}"; do eff+=(--effect "$p"); done
+        eff+=(--strength "$strength")
+    fi
     "$YAWCAST" simulate --world "$world" "${eff[@]}" --records 3 --seed $((100 * seed)) \
         --gyro-noise 0.03 --heading-noise 0.2 --speed-noise 0.02 \
         --out "$dir/trial.csv" >"$dir/simulate.log" 2>&1
@@ -67,8 +73,13 @@ case_run() {
     local verdict="error"
     if "$YAWCAST" diagnose --model "$WORK/$world/ref.postcard" "${refs[@]}" "${data[@]}" \
         --seed "$seed" --json "$dir/diagnosis.json" >"$dir/diagnose.log" 2>&1; then
-        verdict=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["verdict"])' \
-            "$dir/diagnosis.json")
+        # one effect: the verdict; two: the first two significant effects of the ranking
+        verdict=$(python3 -c 'import json,sys
+d = json.load(open(sys.argv[1]))
+if "+" in sys.argv[2]:
+    print("+".join([e["effect"] for e in d["ranking"] if e["significant"]][:2]) or "none")
+else:
+    print(d["verdict"])' "$dir/diagnosis.json" "$effect")
     fi
     printf '%s\t%s\t%s\t%s\t%s\n' "$world" "$strength" "$effect" "$seed" "$verdict"
 }
@@ -103,10 +114,23 @@ secs=$(( $(date +%s) - start ))
 
 python3 - "$work/cases.tsv" "$secs" "$(nproc)" <<'EOF'
 import collections, sys
-rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
+allrows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
+rows = [r for r in allrows if "+" not in r[2]]
+pairs = [r for r in allrows if "+" in r[2]]
 secs, cores = sys.argv[2], sys.argv[3]
-worlds = sorted({r[0] for r in rows}, key=["lng", "kvlcc2", "mariner"].index)
-print(f"# Cross-world diagnosis ({len(rows)} cases, {secs} s on {cores} cores)\n")
+worlds = sorted({r[0] for r in allrows}, key=["lng", "kvlcc2", "mariner"].index)
+print(f"# Cross-world diagnosis ({len(allrows)} cases, {secs} s on {cores} cores)\n")
+if pairs:
+    print("## Two effects: both among the first two significant effects\n")
+    print("| world | strength | pair | cases both named | first two named |")
+    print("|---|---|---|---|---|")
+    for r0 in sorted({(r[0], r[1], r[2]) for r in pairs}, key=lambda k: (worlds.index(k[0]), -float(k[1]), k[2])):
+        cs = [r for r in pairs if (r[0], r[1], r[2]) == r0]
+        both = sum(set(r[2].split("+")) <= set(r[4].split("+")) for r in cs)
+        print(f"| {r0[0]} | {r0[1]} | {r0[2]} | {both}/{len(cs)} | {', '.join(r[4] for r in cs)} |")
+    print()
+if not rows:
+    sys.exit(0)
 print("| world | strength | effect cases right | false alarms (effect-free) | effects right in ≥ 2 of 3 seeds |")
 print("|---|---|---|---|---|")
 for w in worlds:
