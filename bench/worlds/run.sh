@@ -12,7 +12,7 @@
 #   --strengths LIST  comma-separated effect strengths (default 1,0.5)
 #   --effects LIST    comma-separated effects (default: none and every library effect); a
 #                     two-effect case is written a+b (e.g. rate-limit+wind): it is right when
-#                     both are among the first two significant effects of the ranking
+#                     the ranked verdict (`verdict`, then `then`) names both
 #   --jobs J          cases run at once (default 2)
 #
 # Per world: the reference is 3 records of the world's identification input (seeds 900–902,
@@ -52,7 +52,8 @@ fi
 mkdir -p "$work"
 export YAWCAST="$yawcast" WORK="$work"
 
-# one case: world effect strength seed → a line "world<TAB>strength<TAB>effect<TAB>seed<TAB>verdict"
+# one case: world effect strength seed → a line
+# "world<TAB>strength<TAB>effect<TAB>seed<TAB>verdict<TAB>then"
 case_run() {
     local world="$1" effect="$2" strength="$3" seed="$4"
     local dir="$WORK/$world/$effect-$strength-$seed"
@@ -70,16 +71,18 @@ case_run() {
     for i in 1 2 3; do refs+=(--reference "$WORK/$world/ref-$i.csv"); done
     local data=()
     for i in 1 2 3; do data+=(--data "$dir/trial-$i.csv"); done
-    local verdict="error"
+    local verdict="error	-"
     if "$YAWCAST" diagnose --model "$WORK/$world/ref.postcard" "${refs[@]}" "${data[@]}" \
         --seed "$seed" --json "$dir/diagnosis.json" >"$dir/diagnose.log" 2>&1; then
-        # one effect: the verdict; two: the first two significant effects of the ranking
+        # one effect: the verdict; two: the ranked verdict (verdict, then); and the second
+        # effect named, "-" for none
         verdict=$(python3 -c 'import json,sys
 d = json.load(open(sys.argv[1]))
+then = d.get("then") or "-"
 if "+" in sys.argv[2]:
-    print("+".join([e["effect"] for e in d["ranking"] if e["significant"]][:2]) or "none")
+    print(d["verdict"] + ("+" + then if then != "-" else "") + "\t" + then)
 else:
-    print(d["verdict"])' "$dir/diagnosis.json" "$effect")
+    print(d["verdict"] + "\t" + then)' "$dir/diagnosis.json" "$effect")
     fi
     printf '%s\t%s\t%s\t%s\t%s\n' "$world" "$strength" "$effect" "$seed" "$verdict"
 }
@@ -121,7 +124,7 @@ secs, cores = sys.argv[2], sys.argv[3]
 worlds = sorted({r[0] for r in allrows}, key=["lng", "kvlcc2", "mariner"].index)
 print(f"# Cross-world diagnosis ({len(allrows)} cases, {secs} s on {cores} cores)\n")
 if pairs:
-    print("## Two effects: both among the first two significant effects\n")
+    print("## Two effects: both named by the ranked verdict (verdict, then)\n")
     print("| world | strength | pair | cases both named | first two named |")
     print("|---|---|---|---|---|")
     for r0 in sorted({(r[0], r[1], r[2]) for r in pairs}, key=lambda k: (worlds.index(k[0]), -float(k[1]), k[2])):
@@ -131,8 +134,8 @@ if pairs:
     print()
 if not rows:
     sys.exit(0)
-print("| world | strength | effect cases right | false alarms (effect-free) | effects right in ≥ 2 of 3 seeds |")
-print("|---|---|---|---|---|")
+print("| world | strength | effect cases right | false alarms (effect-free) | effects right in ≥ 2 of 3 seeds | a second effect named |")
+print("|---|---|---|---|---|---|")
 for w in worlds:
     for st in sorted({r[1] for r in rows if r[0] == w}, key=float, reverse=True):
         eff = [r for r in rows if r[0] == w and r[1] == st and r[2] != "none"]
@@ -143,7 +146,8 @@ for w in worlds:
         for r in eff:
             by[r[2]].append(r[4] == r[2])
         good = sum(sum(v) * 3 >= 2 * len(v) for v in by.values())
-        print(f"| {w} | {st} | {right}/{len(eff)} | {alarms}/{len(nulls)} | {good}/{len(by)} |")
+        seconds = sum(r[5] != "-" for r in eff)
+        print(f"| {w} | {st} | {right}/{len(eff)} | {alarms}/{len(nulls)} | {good}/{len(by)} | {seconds}/{len(eff)} |")
 print("\n## Verdicts per case (hidden → named)\n")
 for w in worlds:
     for st in sorted({r[1] for r in rows if r[0] == w}, key=float, reverse=True):

@@ -62,6 +62,9 @@ pub struct DiagnoseSummary {
     pub model: String,
     /// Effect name or "none".
     pub verdict: String,
+    /// The second effect of a ranked verdict (measured against the model with the first), or
+    /// null.
+    pub then: Option<String>,
     /// Every effect not already in the model, best first.
     pub ranking: Vec<Ranked>,
     /// Held-out fits of the model.
@@ -136,6 +139,7 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
             seed,
             model: args.model.display().to_string(),
             verdict: d.verdict.clone(),
+            then: d.then.clone(),
             ranking: d.ranking.clone(),
             before: FitSummary {
                 fit: d.before.clone(),
@@ -192,7 +196,10 @@ fn print_report(d: &Diagnosis) {
     };
     println!("held-out fit % (1/5/10/20/sim) before: {}", row(&d.before));
     println!("held-out fit % (1/5/10/20/sim) after:  {}", row(&d.after));
-    println!("verdict: {}", d.verdict);
+    match &d.then {
+        Some(t) => println!("verdict: {}, then {t}", d.verdict),
+        None => println!("verdict: {}", d.verdict),
+    }
     println!("{}", d.explanation);
 }
 

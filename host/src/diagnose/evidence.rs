@@ -332,12 +332,25 @@ pub(super) fn world(
     grids: &[(EffectKind, Vec<Effect>)],
     parallel: bool,
 ) -> Vec<WorldStat> {
-    let tset = Set::new(model, trial);
+    world_with(model, model, reference, trial, grids, parallel)
+}
+
+/// [`world`] with the trials measured against `on_trial` (the model with an effect the
+/// trials show added) and the reference versions found against `model`.
+pub(super) fn world_with(
+    model: &Model,
+    on_trial: &Model,
+    reference: &[Record],
+    trial: &[Record],
+    grids: &[(EffectKind, Vec<Effect>)],
+    parallel: bool,
+) -> Vec<WorldStat> {
+    let tset = Set::new(on_trial, trial);
     let rset = Set::new(model, reference);
     let one = |(kind, cands): &(EffectKind, Vec<Effect>)| {
         let h = horizon_of(*kind);
-        let (t0, tn) = tset.sse0(model, h);
-        let tq = tset.family(model, cands, h, false);
+        let (t0, tn) = tset.sse0(on_trial, h);
+        let tq = tset.family(on_trial, cands, h, false);
         let version = if reference.is_empty() {
             Version {
                 idx: None,

@@ -80,6 +80,7 @@ mod evidence;
 mod null;
 mod reference;
 pub mod resid;
+mod second;
 #[cfg(test)]
 pub(crate) mod tests;
 mod verdict;
@@ -217,6 +218,10 @@ pub struct Diagnosis {
     pub reference_used: bool,
     /// The confirming refit of the verdict's effect, when done.
     pub augment: Option<AugmentReport>,
+    /// The second effect of a ranked verdict ("rate-limit, then nonlinear-damping"): the
+    /// most significant other effect measured against the model with the verdict's effect
+    /// added, or `None`.
+    pub then: Option<String>,
     /// Held-out fit % of the model, keyed by horizon ("1","5","10","20","sim").
     pub before: BTreeMap<String, f64>,
     /// Held-out fit % of the model with the verdict's effect (same as `before` when `none`).
@@ -236,8 +241,8 @@ impl Diagnosis {
     /// use yawcast_shared::model::EffectKind;
     /// let d = Diagnosis {
     ///     verdict: "dead-time".into(), ranking: vec![], explanation: String::new(), caveats: vec![],
-    ///     reference_used: true, augment: None, before: Default::default(), after: Default::default(),
-    ///     reference_gear: None,
+    ///     reference_used: true, augment: None, then: None, before: Default::default(),
+    ///     after: Default::default(), reference_gear: None,
     /// };
     /// assert_eq!(d.verdict_kind(), Some(EffectKind::DeadTime));
     /// ```
@@ -450,6 +455,34 @@ pub fn diagnose(
             effect: k.name().into(),
         });
     }
+    // the second effect of a ranked verdict, against the model with the first added
+    let then = EffectKind::from_name(&verdict_name).and_then(|k1| {
+        let first = ev.iter().find(|e| e.kind == k1)?;
+        let with_first = base.clone().with_effect(first.best);
+        second::second_effect(
+            base,
+            &with_first,
+            k1,
+            reference,
+            est,
+            &grids,
+            &nulls,
+            level,
+            has_ref,
+            cfg,
+            &ch,
+            (&est_part, &held_out),
+        )
+    });
+    if let Some(e) = &then {
+        explanation.push_str(&format!(
+            " Then, against the model with it: {} ({}; p {}).",
+            effect_phrase(e.kind),
+            e.kind.name(),
+            verdict::fmt_p(e.p)
+        ));
+    }
+    let then = then.map(|e| e.kind.name().to_string());
     for c in &caveats {
         explanation.push(' ');
         explanation.push_str(&c.explain());
@@ -461,6 +494,7 @@ pub fn diagnose(
         caveats,
         reference_used: has_ref,
         augment,
+        then,
         before,
         after,
         reference_gear: gear.map(|g| g.model),

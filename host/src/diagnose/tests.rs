@@ -584,3 +584,42 @@ fn a_steady_moment_the_reference_carries_is_tested_for_a_change() {
     let d = diagnose(&rep.model, &refs, &same, &[], &cfg).unwrap();
     assert_eq!(d.verdict, "none", "{}", d.explanation);
 }
+
+#[test]
+fn a_second_effect_is_measured_against_the_model_with_the_first() {
+    // a saturation and a nonlinear damping hidden together: against the model alone the
+    // saturation's remainder reads as a dead band; against the model with the saturation
+    // the damping is what is left
+    let refs = records(None, &[900, 901, 902]);
+    let model = identify(&refs);
+    let cfg = DiagnoseConfig {
+        seed: 4,
+        ..DiagnoseConfig::default()
+    };
+    let mut sc = Scenario {
+        effects: vec![
+            SimEffect::hidden(EffectKind::Saturation, 1.0),
+            SimEffect::hidden(EffectKind::NonlinearDamping, 1.0),
+        ],
+        ..Scenario::default()
+    };
+    sc.noise = noise();
+    let two: Vec<Record> = [40u64, 41, 42]
+        .par_iter()
+        .map(|&s| simulate(&Ship::default_lng(), &sc, s).unwrap())
+        .collect();
+    let d = diagnose(&model, &refs, &two, &[], &cfg).unwrap();
+    assert_eq!(d.verdict, "saturation", "{}", d.explanation);
+    assert_eq!(
+        d.then.as_deref(),
+        Some("nonlinear-damping"),
+        "{}",
+        d.explanation
+    );
+    assert!(d.explanation.contains("Then, against the model with it"));
+    // the saturation alone: nothing second
+    let one = records(Some((EffectKind::Saturation, 1.0)), &[40, 41, 42]);
+    let d = diagnose(&model, &refs, &one, &[], &cfg).unwrap();
+    assert_eq!(d.verdict, "saturation", "{}", d.explanation);
+    assert_eq!(d.then, None, "{}", d.explanation);
+}

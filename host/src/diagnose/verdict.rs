@@ -686,7 +686,7 @@ pub(super) fn split(est: &[Record]) -> (Vec<Record>, Vec<Record>) {
 }
 
 /// `= 3.1e-5`, or `< 1e-16` where the number is below what the tail computation resolves.
-fn fmt_p(p: f64) -> String {
+pub(super) fn fmt_p(p: f64) -> String {
     if p < 1e-16 {
         "< 1e-16".into()
     } else {

@@ -1,0 +1,89 @@
+//! The second effect of a ranked verdict: every other effect measured again on the trials
+//! against the model with the verdict's effect added.
+
+use yawcast_shared::model::EffectKind;
+
+use super::channels::Channels;
+use super::compare::mean_fit;
+use super::evidence::{world_with, Set};
+use super::verdict::{effect_evidence, frozen_gain, rank, Evidence, GAIN_PP};
+use super::DiagnoseConfig;
+use crate::effects::{def, Channel};
+use crate::identify::model::{Effect, Model};
+use crate::identify::predict::Horizon;
+use crate::io::data::Record;
+
+/// What the trials show beside the verdict's effect `first`: each other effect's statistic
+/// `D` measured on the trials against `with_first` (the model with `first` at its trial
+/// version, θ frozen as in the first stage), the reference versions still found against
+/// `base` (the reference lacks `first`), judged against the first stage's null replicates
+/// (`nulls[i]` for `grids[i]`: the null of an effect's statistic depends on its grid and the
+/// records, not on what else the model carries). Current and wind share speed over ground's
+/// evidence, so beside either the other is not a second effect. The others are ranked by the
+/// first stage's rule ([`rank`]); the second effect is the first of them that is significant
+/// at `level` and improves prediction on `held` (estimation part, held-out part) by
+/// [`GAIN_PP`] or more — θ frozen leaves part of the first effect in the errors, which reads
+/// as its neighbour (a saturation's remainder as an asymmetry) without improving prediction
+/// — or that its own channel shows with no yaw-rate part (a gyro offset, a current from
+/// speed over ground alone); `None` without one.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn second_effect(
+    base: &Model,
+    with_first: &Model,
+    first: EffectKind,
+    reference: &[Record],
+    est: &[Record],
+    grids: &[(EffectKind, Vec<Effect>)],
+    nulls: &[Vec<f64>],
+    level: f64,
+    has_ref: bool,
+    cfg: &DiagnoseConfig,
+    ch: &Channels,
+    held: (&[Record], &[Record]),
+) -> Option<Evidence> {
+    let k1 = first;
+    let shares_speed = |k: EffectKind| {
+        matches!(
+            (k1, k),
+            (EffectKind::Current, EffectKind::Wind) | (EffectKind::Wind, EffectKind::Current)
+        )
+    };
+    let keep: Vec<usize> = (0..grids.len())
+        .filter(|&i| grids[i].0 != k1 && !shares_speed(grids[i].0))
+        .collect();
+    let rest: Vec<(EffectKind, Vec<Effect>)> = keep.iter().map(|&i| grids[i].clone()).collect();
+    let stats = world_with(base, with_first, reference, est, &rest, cfg.parallel);
+    let mut ev: Vec<Evidence> = keep
+        .iter()
+        .zip(&stats)
+        .map(|(&i, st)| {
+            effect_evidence(
+                with_first, grids[i].0, st, &nulls[i], has_ref, cfg, ch.hb, ch.sog,
+            )
+        })
+        .collect();
+    // the first stage's ranking, on the model with the first effect; then the first
+    // significant effect that improves held-out prediction by the ranking rule's GAIN_PP
+    // (what a second effect adds beside the first is judged on prediction, not on the
+    // statistic alone: θ frozen leaves part of the first in the errors), or that its own
+    // channel shows with nothing in the yaw rate to gain (a gyro offset from the heading, a
+    // current from speed over ground alone)
+    let trial = Set::new(with_first, est);
+    rank(
+        with_first,
+        &trial,
+        &mut ev,
+        &rest,
+        level,
+        cfg,
+        ch.sog.is_some(),
+    );
+    let before = mean_fit(with_first, held.1, &Horizon::REPORT);
+    let est_set = Set::new(with_first, held.0);
+    let pick = ev.iter().position(|e| {
+        e.p < level
+            && ((e.channel_material && (e.speed_only || def(e.kind).channel == Channel::Heading))
+                || frozen_gain(with_first, e, &est_set, held.1, &before, cfg.parallel).0 >= GAIN_PP)
+    })?;
+    Some(ev.swap_remove(pick))
+}
