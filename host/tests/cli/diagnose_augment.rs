@@ -68,7 +68,12 @@ fn diagnose_names_a_hidden_dead_time_and_writes_stable_json() {
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(v["verdict"], "dead-time");
     // one effect hidden: no second effect of a ranked verdict (the field is there, null)
-    assert_eq!(v.get("then"), Some(&serde_json::Value::Null), "{}", v["explanation"]);
+    assert_eq!(
+        v.get("then"),
+        Some(&serde_json::Value::Null),
+        "{}",
+        v["explanation"]
+    );
     assert_eq!(v["seed"], 5);
     assert_eq!(v["reference_used"], true);
     // references given, heading and speed logged, short records: nothing qualifies it but
