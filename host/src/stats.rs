@@ -228,6 +228,31 @@ pub fn f_sf(f: f64, d1: f64, d2: f64) -> f64 {
     beta_reg(d2 / (d2 + d1 * f), 0.5 * d2, 0.5 * d1)
 }
 
+/// The F quantile with upper-tail probability `p` (0 < p < 1): the `f` with
+/// `P(F > f) = p` for `d1` and `d2` degrees of freedom, by doubling then bisection on
+/// [`f_sf`] (100 halvings).
+///
+/// ```
+/// use yawcast::stats::f_quantile;
+/// // F(2, 2): P(F > f) = 1/(1 + f), so the 1 % point is 99
+/// assert!((f_quantile(0.01, 2.0, 2.0) - 99.0).abs() < 1e-9);
+/// ```
+pub fn f_quantile(p: f64, d1: f64, d2: f64) -> f64 {
+    let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+    while f_sf(hi, d1, d2) > p && hi < 1e12 {
+        hi *= 2.0;
+    }
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if f_sf(mid, d1, d2) > p {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hi
+}
+
 /// Student t upper-tail probability P(T > t) with `dof` degrees of freedom (`dof > 0`).
 ///
 /// ```

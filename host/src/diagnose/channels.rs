@@ -11,7 +11,7 @@ use super::verdict::{cfg_m, Evidence};
 use super::{heading_bias, DiagnoseConfig};
 use crate::effects::{def, Channel};
 use crate::io::data::Record;
-use crate::stats::{f_sf, normal_sf};
+use crate::stats::{f_quantile, f_sf, normal_sf};
 
 /// What heading and speed over ground show on the trials against the reference: whether
 /// every record logs them, the gyro offset the heading shows (trial minus reference when
@@ -230,21 +230,9 @@ impl SogEvidence {
     /// direction: the amplitude whose χ² (along the direction the records resolve worst)
     /// reaches the level's critical value.
     pub(super) fn smallest_current(&self, level: f64) -> f64 {
-        // the critical F (2, inflation_df) by bisection on its tail
-        let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
-        while f_sf(hi, 2.0, self.inflation_df[0]) > level && hi < 1e12 {
-            hi *= 2.0;
-        }
-        for _ in 0..100 {
-            let mid = 0.5 * (lo + hi);
-            if f_sf(mid, 2.0, self.inflation_df[0]) > level {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
+        let f = f_quantile(level, 2.0, self.inflation_df[0]);
         // χ²/inflation = a²/var1 = 2·F
-        (2.0 * hi * self.var1).sqrt()
+        (2.0 * f * self.var1).sqrt()
     }
 
     /// The calibration in words, empty when the records show no aliasing.

@@ -458,11 +458,9 @@ pub fn diagnose(
     // the second effect of a ranked verdict, against the model with the first added
     let then = EffectKind::from_name(&verdict_name).and_then(|k1| {
         let first = ev.iter().find(|e| e.kind == k1)?;
-        let with_first = base.clone().with_effect(first.best);
         second::second_effect(
             base,
-            &with_first,
-            k1,
+            &first.best,
             reference,
             est,
             &grids,

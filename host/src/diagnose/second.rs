@@ -14,8 +14,8 @@ use crate::identify::predict::Horizon;
 use crate::io::data::Record;
 
 /// What the trials show beside the verdict's effect `first`: each other effect's statistic
-/// `D` measured on the trials against `with_first` (the model with `first` at its trial
-/// version, θ frozen as in the first stage), the reference versions still found against
+/// `D` measured on the trials against the model with `first` (its trial version, θ frozen as
+/// in the first stage), the reference versions still found against
 /// `base` (the reference lacks `first`), judged against the first stage's null replicates
 /// (`nulls[i]` for `grids[i]`: the null of an effect's statistic depends on its grid and the
 /// records, not on what else the model carries). Current and wind share speed over ground's
@@ -29,8 +29,7 @@ use crate::io::data::Record;
 #[allow(clippy::too_many_arguments)]
 pub(super) fn second_effect(
     base: &Model,
-    with_first: &Model,
-    first: EffectKind,
+    first: &Effect,
     reference: &[Record],
     est: &[Record],
     grids: &[(EffectKind, Vec<Effect>)],
@@ -41,7 +40,8 @@ pub(super) fn second_effect(
     ch: &Channels,
     held: (&[Record], &[Record]),
 ) -> Option<Evidence> {
-    let k1 = first;
+    let k1 = first.kind();
+    let with_first = &base.clone().with_effect(*first);
     let shares_speed = |k: EffectKind| {
         matches!(
             (k1, k),
