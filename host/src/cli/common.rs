@@ -96,7 +96,8 @@ pub struct ReadArgs {
     #[arg(long, value_name = "NAME", default_value = "wind_angle_deg")]
     pub col_wind_angle: String,
     /// CSV column holding the course over ground in degrees (optional; with --col-speed it
-    /// gives the ground velocity of the heading and track prediction).
+    /// gives the ground velocity of the heading and track prediction, and diagnose's
+    /// current its cross-track channel).
     #[arg(long, value_name = "NAME", default_value = "cog_deg")]
     pub col_cog: String,
     /// CSV column holding the latitude in degrees (optional; position fixes, with --col-lon).
@@ -187,6 +188,7 @@ impl ReadArgs {
             speed: self.col_speed.clone(),
             wind_speed: self.col_wind_speed.clone(),
             wind_angle: self.col_wind_angle.clone(),
+            cog: self.col_cog.clone(),
             angle_scale: match self.angle_unit {
                 AngleUnit::Deg => 1.0,
                 AngleUnit::Rad => rad,

@@ -65,26 +65,88 @@ impl Channels {
     }
 }
 
-/// Coefficients of (sin ψ, cos ψ, sin 2ψ, cos 2ψ) in speed over ground; nuisance: one
-/// intercept per record and r² and δ² low-passed through each time constant of
-/// [`sog_taus`] (speed lost in turns and to rudder/pod drag, whatever the ship's surge time
-/// constant). `shift[i]` circularly shifts record i's heading against its speed (0: aligned).
-fn sog_harmonics(recs: &[&Record], shift: &[usize], taus: &[f64]) -> Option<DVector<f64>> {
+/// Which component of the ground velocity is regressed on the heading harmonics.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Lane {
+    /// Speed over ground: the ship's speed through the water plus the current along the
+    /// heading. Nuisance: the speed lost in turns and to rudder/pod drag, r² and δ² through
+    /// the surge lags of [`sog_taus`].
+    Along,
+    /// Speed over ground times the sine of course over ground less heading: the sway
+    /// velocity plus the current across the heading. Nuisance: the sway, linear in r and δ
+    /// (as they are and through the lags of [`CROSS_TAUS_S`]). Samples whose course is
+    /// missing, or whose speed is too low to give one, are skipped.
+    Cross,
+}
+
+/// Time constants (s) of the sway nuisance of the cross-track lane: a hull's sway time
+/// constant is about `L/U` (≈ 5 s on a model ship, ≈ 40 s on a full-scale tanker).
+const CROSS_TAUS_S: [f64; 4] = [3.0, 10.0, 30.0, 90.0];
+/// Speed over ground (m/s) below which a course is not used.
+const CROSS_MIN_SPEED: f64 = 0.1;
+
+/// Coefficients of (sin ψ, cos ψ, sin 2ψ, cos 2ψ) in the lane's component of the ground
+/// velocity; nuisance: one intercept per record and the lane's own regressors (see
+/// [`Lane`]). `shift[i]` circularly shifts record i's heading against its speed (0: aligned);
+/// `remove` is a heading dependence (coefficients as returned) taken out of the target at the
+/// true heading first, as the null draws do.
+fn sog_harmonics(
+    lane: Lane,
+    recs: &[&Record],
+    shift: &[usize],
+    taus: &[f64],
+    remove: Option<&DVector<f64>>,
+) -> Option<DVector<f64>> {
     let nr = recs.len();
+    let taus: &[f64] = match lane {
+        Lane::Along => taus,
+        Lane::Cross => &CROSS_TAUS_S,
+    };
     let nt = taus.len();
-    let p = nr + 4 + 2 * nt;
+    let own = match lane {
+        Lane::Along => 2 * nt,
+        Lane::Cross => 2 * nt + 2,
+    };
+    let p = nr + 4 + own;
     let mut xtx = DMatrix::<f64>::zeros(p, p);
     let mut xty = DVector::<f64>::zeros(p);
     let mut x = DVector::<f64>::zeros(p);
+    let mut rows = 0usize;
     for (i, r) in recs.iter().enumerate() {
         let psi = r.psi.as_ref()?;
         let sp = r.speed.as_ref()?;
+        let cog = match lane {
+            Lane::Along => None,
+            Lane::Cross => Some(r.cog.as_ref()?),
+        };
         let a: Vec<f64> = taus.iter().map(|tau| (r.ts / tau).min(1.0)).collect();
         let mut lr = vec![0.0; nt];
         let mut lu = vec![0.0; nt];
         let n = r.len();
         let sh = shift.get(i).copied().unwrap_or(0) % n.max(1);
         for t in 0..n {
+            let (fr, fu) = match lane {
+                Lane::Along => (r.y[t] * r.y[t], r.u[t] * r.u[t]),
+                Lane::Cross => (r.y[t], r.u[t]),
+            };
+            for k in 0..nt {
+                lr[k] += a[k] * (fr - lr[k]);
+                lu[k] += a[k] * (fu - lu[k]);
+            }
+            let mut target = match cog {
+                None => sp[t],
+                Some(c) => {
+                    if !(c[t].is_finite() && sp[t] >= CROSS_MIN_SPEED) {
+                        continue;
+                    }
+                    sp[t] * (c[t] - psi[t]).to_radians().sin()
+                }
+            };
+            if let Some(b) = remove {
+                let p0 = psi[t].to_radians();
+                let h0 = [p0.sin(), p0.cos(), (2.0 * p0).sin(), (2.0 * p0).cos()];
+                target -= (0..4).map(|j| h0[j] * b[j]).sum::<f64>();
+            }
             let ph = psi[(t + sh) % n].to_radians();
             let h = [ph.sin(), ph.cos(), (2.0 * ph).sin(), (2.0 * ph).cos()];
             x.fill(0.0);
@@ -93,14 +155,20 @@ fn sog_harmonics(recs: &[&Record], shift: &[usize], taus: &[f64]) -> Option<DVec
                 x[nr + j] = *hj;
             }
             for k in 0..nt {
-                lr[k] += a[k] * (r.y[t] * r.y[t] - lr[k]);
-                lu[k] += a[k] * (r.u[t] * r.u[t] - lu[k]);
                 x[nr + 4 + 2 * k] = lr[k];
                 x[nr + 5 + 2 * k] = lu[k];
             }
+            if lane == Lane::Cross {
+                x[nr + 4 + 2 * nt] = fr;
+                x[nr + 5 + 2 * nt] = fu;
+            }
             xtx.ger(1.0, &x, &x, 1.0);
-            xty.axpy(sp[t], &x, 1.0);
+            xty.axpy(target, &x, 1.0);
+            rows += 1;
         }
+    }
+    if rows < 2 * p {
+        return None;
     }
     // the filter bank's columns are strongly correlated: a relative ridge keeps the solve
     // well posed without moving the (orthogonal) heading harmonics
@@ -146,8 +214,16 @@ const SOG_SHIFTS: usize = 60;
 
 /// Covariance of the harmonics under "no heading dependence": heading circularly shifted
 /// against speed by random amounts (10–90 % of each record), which keeps both series'
-/// own structure.
-fn sog_null_cov(recs: &[&Record], taus: &[f64], rng: &mut ChaCha8Rng) -> Option<DMatrix<f64>> {
+/// own structure. The heading dependence the records show is taken out first: a strong
+/// one (a current of a knot) is itself a slow series, and shifted against the heading it
+/// would pass for noise and hide itself.
+fn sog_null_cov(
+    lane: Lane,
+    recs: &[&Record],
+    taus: &[f64],
+    rng: &mut ChaCha8Rng,
+) -> Option<DMatrix<f64>> {
+    let own = sog_harmonics(lane, recs, &[], taus, None)?;
     let mut draws = Vec::with_capacity(SOG_SHIFTS);
     for _ in 0..SOG_SHIFTS {
         let sh: Vec<usize> = recs
@@ -157,7 +233,7 @@ fn sog_null_cov(recs: &[&Record], taus: &[f64], rng: &mut ChaCha8Rng) -> Option<
                 rng.random_range(n / 10..=(9 * n / 10).max(n / 10 + 1))
             })
             .collect();
-        draws.push(sog_harmonics(recs, &sh, taus)?);
+        draws.push(sog_harmonics(lane, recs, &sh, taus, Some(&own))?);
     }
     let m = draws.len() as f64;
     let mean = draws.iter().fold(DVector::zeros(4), |a, b| a + b) / m;
@@ -210,12 +286,51 @@ pub(super) struct SogEvidence {
     /// Largest variance (m/s)² of the first harmonic in any direction (the circular-shift
     /// null's, times the inflation): what the records can resolve.
     pub(super) var1: f64,
+    /// The current seen across the track as well, when every record logs course over
+    /// ground.
+    pub(super) cross: Option<CrossEvidence>,
+}
+
+/// A uniform current seen by both components of the ground velocity: along the heading
+/// (speed over ground's first harmonic, `(c_N, c_E) = (b_cos, b_sin)`) and across it (speed
+/// over ground times the sine of course less heading, `(c_N, c_E) = (−b_sin, b_cos)`). Each
+/// lane is calibrated on its own splits; the two estimates are combined by their inverse
+/// calibrated covariances. A current moves both lanes alike; what else varies with heading
+/// (speed lost in turns, wind drag and leeway) moves them differently, which `agree` tests.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct CrossEvidence {
+    /// Combined current (north, east; m/s), trial minus reference.
+    pub(super) current: [f64; 2],
+    /// Wald χ² (2 df) of the combined current against its calibrated covariance.
+    pub(super) chi: f64,
+    /// Denominator degrees of freedom of its F test (∞: none calibrated).
+    pub(super) df: f64,
+    /// Largest variance (m/s)² of the combined current in any direction.
+    pub(super) var: f64,
+    /// The cross-track lane alone: calibrated χ² (2 df) and its inflation.
+    pub(super) cross_chi: f64,
+    /// Inflation of the cross-track lane's χ² (≥ 1).
+    pub(super) cross_inflation: f64,
+    /// χ² (2 df) of the difference between the two lanes' currents: large when what varies
+    /// with heading is not one uniform current.
+    pub(super) agree: f64,
+}
+
+impl CrossEvidence {
+    /// Speed (m/s) and the direction it sets towards (deg).
+    pub(super) fn speed_dir(&self) -> (f64, f64) {
+        let [n, e] = self.current;
+        (n.hypot(e), e.atan2(n).to_degrees().rem_euclid(360.0))
+    }
 }
 
 impl SogEvidence {
     /// `(χ², df, p)` of what speed over ground shows: the first harmonic for a current, both
     /// for wind.
     pub(super) fn test(&self, current: bool) -> (f64, f64, f64) {
+        if let (true, Some(c)) = (current, self.cross) {
+            return (c.chi, 2.0, f_sf(c.chi / 2.0, 2.0, c.df));
+        }
         if current {
             let p = f_sf(self.chi1 / 2.0, 2.0, self.inflation_df[0]);
             (self.chi1, 2.0, p)
@@ -230,6 +345,9 @@ impl SogEvidence {
     /// direction: the amplitude whose χ² (along the direction the records resolve worst)
     /// reaches the level's critical value.
     pub(super) fn smallest_current(&self, level: f64) -> f64 {
+        if let Some(c) = self.cross {
+            return (2.0 * f_quantile(level, 2.0, c.df) * c.var).sqrt();
+        }
         let f = f_quantile(level, 2.0, self.inflation_df[0]);
         // χ²/inflation = a²/var1 = 2·F
         (2.0 * f * self.var1).sqrt()
@@ -272,42 +390,51 @@ pub(super) fn sog_evidence(
 /// Harmonics of `trial` minus those of `reference` (none when empty) with the circular-shift
 /// covariance of the difference.
 fn sog_difference(
+    lane: Lane,
     trial: &[&Record],
     reference: &[&Record],
     taus: &[f64],
     rng: &mut ChaCha8Rng,
 ) -> Option<(DVector<f64>, DMatrix<f64>)> {
-    let t = sog_harmonics(trial, &[], taus)?;
-    let vt = sog_null_cov(trial, taus, rng)?;
+    let t = sog_harmonics(lane, trial, &[], taus, None)?;
+    let vt = sog_null_cov(lane, trial, taus, rng)?;
     if reference.is_empty() {
         return Some((t, vt));
     }
-    let r = sog_harmonics(reference, &[], taus)?;
-    let vr = sog_null_cov(reference, taus, rng)?;
+    let r = sog_harmonics(lane, reference, &[], taus, None)?;
+    let vr = sog_null_cov(lane, reference, taus, rng)?;
     Some((t - r, vt + vr))
 }
 
-/// [`sog_evidence`] with the nuisance time constants given.
-pub(super) fn sog_evidence_with(
-    trial: &[Record],
-    reference: &[Record],
-    seed: u64,
+/// One lane's harmonics (trial minus reference), their covariance, the χ² of the first
+/// and second harmonic before calibration, and the calibration: inflation and its degrees
+/// of freedom per harmonic, from each record against the others of its own set.
+struct LaneStat {
+    d: DVector<f64>,
+    v: DMatrix<f64>,
+    raw: [f64; 2],
+    inflation: [f64; 2],
+    inflation_df: [f64; 2],
+}
+
+fn lane_stat(
+    lane: Lane,
+    trial: &[&Record],
+    reference: &[&Record],
     taus: &[f64],
-) -> Option<SogEvidence> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5047_5f53_4f47);
-    let trial: Vec<&Record> = trial.iter().collect();
-    let reference: Vec<&Record> = reference.iter().collect();
-    let (d, v) = sog_difference(&trial, &reference, taus, &mut rng)?;
+    rng: &mut ChaCha8Rng,
+) -> Option<LaneStat> {
+    let (d, v) = sog_difference(lane, trial, reference, taus, rng)?;
     // each record against the others of its set: the aliasing without a current
     let mut sums = [0.0; 2];
     let mut splits = 0usize;
-    for set in [&reference, &trial] {
+    for set in [reference, trial] {
         if set.len() < 2 {
             continue;
         }
         for j in 0..set.len() {
             let rest: Vec<&Record> = (0..set.len()).filter(|&i| i != j).map(|i| set[i]).collect();
-            if let Some((dj, vj)) = sog_difference(&set[j..=j], &rest, taus, &mut rng) {
+            if let Some((dj, vj)) = sog_difference(lane, &set[j..=j], &rest, taus, rng) {
                 sums[0] += wald(&dj, &vj, &[0, 1]);
                 sums[1] += wald(&dj, &vj, &[2, 3]);
                 splits += 1;
@@ -326,16 +453,74 @@ pub(super) fn sog_evidence_with(
             }
         }
     }
-    Some(SogEvidence {
-        chi1: raw[0] / inflation[0],
-        chi2: raw[1] / inflation[1],
+    Some(LaneStat {
+        d,
+        v,
         raw,
         inflation,
         inflation_df,
+    })
+}
+
+/// [`sog_evidence`] with the nuisance time constants given.
+pub(super) fn sog_evidence_with(
+    trial: &[Record],
+    reference: &[Record],
+    seed: u64,
+    taus: &[f64],
+) -> Option<SogEvidence> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5047_5f53_4f47);
+    let trial: Vec<&Record> = trial.iter().collect();
+    let reference: Vec<&Record> = reference.iter().collect();
+    let a = lane_stat(Lane::Along, &trial, &reference, taus, &mut rng)?;
+    let with_course = trial.iter().chain(&reference).all(|r| r.cog.is_some());
+    let cross = if with_course {
+        lane_stat(Lane::Cross, &trial, &reference, taus, &mut rng)
+            .and_then(|x| combine_current(&a, &x))
+    } else {
+        None
+    };
+    let (d, v, inflation) = (&a.d, &a.v, a.inflation);
+    Some(SogEvidence {
+        chi1: a.raw[0] / inflation[0],
+        chi2: a.raw[1] / inflation[1],
+        raw: a.raw,
+        inflation,
+        inflation_df: a.inflation_df,
         amp1: d[0].hypot(d[1]),
         dir1: d[0].atan2(d[1]).to_degrees().rem_euclid(360.0),
         amp2: d[2].hypot(d[3]),
         var1: inflation[0] * largest_eigenvalue(v[(0, 0)], v[(0, 1)], v[(1, 1)]),
+        cross,
+    })
+}
+
+/// The current of each lane as (north, east) with its calibrated covariance, combined.
+fn combine_current(a: &LaneStat, x: &LaneStat) -> Option<CrossEvidence> {
+    // along: (c_N, c_E) = (b_cos, b_sin); across: (c_N, c_E) = (−b_sin, b_cos)
+    let ca = nalgebra::Vector2::new(a.d[1], a.d[0]);
+    let va =
+        nalgebra::Matrix2::new(a.v[(1, 1)], a.v[(1, 0)], a.v[(0, 1)], a.v[(0, 0)]) * a.inflation[0];
+    let cx = nalgebra::Vector2::new(-x.d[0], x.d[1]);
+    let vx = nalgebra::Matrix2::new(x.v[(0, 0)], -x.v[(0, 1)], -x.v[(1, 0)], x.v[(1, 1)])
+        * x.inflation[0];
+    let (ia, ix) = (va.try_inverse()?, vx.try_inverse()?);
+    let info = ia + ix;
+    let cov = info.try_inverse()?;
+    let c = cov * (ia * ca + ix * cx);
+    let chi = c.dot(&(info * c)).max(0.0);
+    let diff = ca - cx;
+    let agree = (va + vx)
+        .try_inverse()
+        .map_or(0.0, |i| diff.dot(&(i * diff)).max(0.0));
+    Some(CrossEvidence {
+        current: [c[0], c[1]],
+        chi,
+        df: a.inflation_df[0].min(x.inflation_df[0]),
+        var: largest_eigenvalue(cov[(0, 0)], cov[(0, 1)], cov[(1, 1)]),
+        cross_chi: x.raw[0] / x.inflation[0],
+        cross_inflation: x.inflation[0],
+        agree,
     })
 }
 
@@ -385,7 +570,34 @@ pub(super) fn add_channels(
                 ev.p = (2.0 * p_yaw.min(p_sog)).min(1.0);
                 ev.score = ev.score.max(chi - df);
                 ev.channel_material = p_sog < cfg.alpha / cfg_m(cfg);
-                if kind == EffectKind::Current {
+                if let (EffectKind::Current, Some(c)) = (kind, s.cross) {
+                    let (speed, dir) = c.speed_dir();
+                    ev.parameter = Some(speed);
+                    ev.words.push_str(&format!(
+                        "; the ground velocity shows a current of {speed:.3} m/s setting towards \
+                         {dir:.0}° (speed over ground along the heading, course over ground \
+                         across it; χ² = {chi:.1}, 2 df, across alone {:.1}{}{})",
+                        c.cross_chi,
+                        if c.cross_inflation > 1.0 || s.inflation[0] > 1.0 {
+                            format!(
+                                "; each lane's χ² divided by what the records show against each \
+                                 other without a current: {:.1} along, {:.1} across",
+                                s.inflation[0], c.cross_inflation
+                            )
+                        } else {
+                            String::new()
+                        },
+                        if c.agree > 13.8 {
+                            format!(
+                                "; the two lanes disagree (χ² = {:.1}, 2 df): not all of it \
+                                 is a uniform current",
+                                c.agree
+                            )
+                        } else {
+                            String::new()
+                        }
+                    ));
+                } else if kind == EffectKind::Current {
                     ev.parameter = Some(s.amp1);
                     ev.words.push_str(&format!(
                         "; speed over ground varies by ±{:.3} m/s with heading, fastest heading \

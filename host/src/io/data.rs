@@ -1,6 +1,7 @@
 //! Measurement records: the uniform-sampled time series every tool works on, and the CSV format.
 //!
-//! CSV header (units in the names): `t_s,delta_deg,r_degps[,psi_deg][,u_mps][,wind_speed_mps,wind_angle_deg]`.
+//! CSV header (units in the names):
+//! `t_s,delta_deg,r_degps[,psi_deg][,u_mps][,wind_speed_mps,wind_angle_deg][,cog_deg]`.
 //! `delta_deg` is the *commanded* angle, held over `[t, t+Ts)`.
 
 use std::path::PathBuf;
@@ -51,6 +52,9 @@ pub struct Record {
     pub wind_speed: Option<Vec<f64>>,
     /// Relative wind angle from the bow (deg), when logged.
     pub wind_angle: Option<Vec<f64>>,
+    /// Course over ground (deg from north, clockwise), when logged; `NaN` where a sample is
+    /// missing (a GPS drop-out), which every use skips.
+    pub cog: Option<Vec<f64>>,
 }
 
 /// Errors reading or writing records.
@@ -229,6 +233,7 @@ impl Record {
             speed: cut(&self.speed),
             wind_speed: cut(&self.wind_speed),
             wind_angle: cut(&self.wind_angle),
+            cog: cut(&self.cog),
         }
     }
 }

@@ -390,7 +390,12 @@ pub fn csv_text_with_nav(
     north_m: &[f64],
     east_m: &[f64],
 ) -> String {
-    let base = crate::io::data::csv_text(rec);
+    // the course is written here, once, whether or not the record carries it
+    let bare = crate::io::data::Record {
+        cog: None,
+        ..rec.clone()
+    };
+    let base = crate::io::data::csv_text(&bare);
     let mut out = String::with_capacity(base.len() + 32 * rec.len());
     for (i, line) in base.lines().enumerate() {
         out.push_str(line);

@@ -417,6 +417,8 @@ pub fn simulate_with_nav(
         speed: Some(Vec::with_capacity(n)),
         wind_speed: scenario.log_wind.then(|| Vec::with_capacity(n)),
         wind_angle: scenario.log_wind.then(|| Vec::with_capacity(n)),
+        // the course is the navigation part's (`SimNav`), written beside the record
+        cog: None,
     };
     let mut cmds = Vec::with_capacity(n);
     let spec = RunSpec {

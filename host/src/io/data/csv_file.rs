@@ -21,6 +21,9 @@ pub struct Columns {
     pub wind_speed: String,
     /// Relative wind angle (optional column).
     pub wind_angle: String,
+    /// Course over ground in degrees (optional column; an empty or `NaN` cell is a missing
+    /// sample; not scaled by `angle_scale`, as the navigation reader takes it).
+    pub cog: String,
     /// Multiply the angle columns (`u`, `psi`, `wind_angle`) by this to get degrees.
     pub angle_scale: f64,
     /// Multiply the yaw-rate column by this to get deg/s.
@@ -39,6 +42,7 @@ impl Default for Columns {
             speed: "u_mps".into(),
             wind_speed: "wind_speed_mps".into(),
             wind_angle: "wind_angle_deg".into(),
+            cog: "cog_deg".into(),
             angle_scale: 1.0,
             rate_scale: 1.0,
             resample: None,
@@ -125,12 +129,14 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
     let isp = find(&cols.speed);
     let iws = find(&cols.wind_speed);
     let iwa = find(&cols.wind_angle);
+    let icog = find(&cols.cog);
     let mut rec = Record {
         name: name.to_string(),
         psi: ipsi.map(|_| Vec::new()),
         speed: isp.map(|_| Vec::new()),
         wind_speed: iws.map(|_| Vec::new()),
         wind_angle: iwa.map(|_| Vec::new()),
+        cog: icog.map(|_| Vec::new()),
         ..Record::default()
     };
     for (i, row) in rdr.records().enumerate() {
@@ -168,6 +174,13 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
         }
         if let (Some(i), Some(v)) = (iwa, rec.wind_angle.as_mut()) {
             v.push(cell(i)? * cols.angle_scale);
+        }
+        if let (Some(i), Some(v)) = (icog, rec.cog.as_mut()) {
+            // a GPS drop-out leaves the course empty (or NaN): missing, not an error
+            let s = row.get(i).unwrap_or("");
+            let missing = s.is_empty() || s.eq_ignore_ascii_case("nan");
+            // degrees whatever --angle-unit says, as the navigation reader takes it
+            v.push(if missing { f64::NAN } else { cell(i)? });
         }
     }
     if rec.t.len() < 2 {
@@ -274,7 +287,22 @@ pub fn resample(rec: &Record, dt: f64, path: &Path) -> Result<Record, DataError>
         speed: rec.speed.as_deref().map(linear),
         wind_speed: rec.wind_speed.as_deref().map(linear),
         wind_angle: rec.wind_angle.as_deref().map(unwrapped),
+        cog: rec.cog.as_deref().map(|c| course(c, &at)),
     })
+}
+
+/// A course (deg) at the grid points `at` (interval and place in it): the unit vectors
+/// interpolated, so a course through north stays near north; a missing end leaves the
+/// point missing (`NaN`).
+fn course(c: &[f64], at: &[(usize, f64)]) -> Vec<f64> {
+    at.iter()
+        .map(|&(j, w)| {
+            let (s0, c0) = c[j].to_radians().sin_cos();
+            let (s1, c1) = c[j + 1].to_radians().sin_cos();
+            let (s, c) = (s0 + w * (s1 - s0), c0 + w * (c1 - c0));
+            s.atan2(c).to_degrees().rem_euclid(360.0)
+        })
+        .collect()
 }
 
 /// Whether the CSV text is `;`-separated (the spreadsheet export of locales with a decimal
@@ -311,6 +339,7 @@ pub fn csv_text(rec: &Record) -> String {
         (&rec.speed, "u_mps"),
         (&rec.wind_speed, "wind_speed_mps"),
         (&rec.wind_angle, "wind_angle_deg"),
+        (&rec.cog, "cog_deg"),
     ];
     for (v, name) in &opt {
         if v.is_some() {

@@ -20,6 +20,44 @@ fn reads_optional_columns() {
 }
 
 #[test]
+fn course_over_ground_has_holes_not_errors() {
+    // a GPS drop-out leaves the course empty or NaN: missing, kept as NaN
+    let txt =
+        "t_s,delta_deg,r_degps,u_mps,cog_deg\n0,1,0,2,359\n1,1,0,2,\n2,1,0,2,NaN\n3,1,0,2,1\n";
+    let r = parse(txt).unwrap();
+    let c = r.cog.as_ref().unwrap();
+    assert_eq!(c[0], 359.0);
+    assert!(c[1].is_nan() && c[2].is_nan());
+    assert_eq!(c[3], 1.0);
+    // degrees whatever --angle-unit says (as the navigation reader takes it)
+    let rad = Columns {
+        angle_scale: 180.0 / std::f64::consts::PI,
+        ..Columns::default()
+    };
+    let r2 = parse_csv(txt, Path::new("f.csv"), "f", &rad).unwrap();
+    assert_eq!(r2.cog.as_ref().unwrap()[3], 1.0);
+    // text that is not a number is still an error naming row and column
+    let e = parse("t_s,delta_deg,r_degps,cog_deg\n0,1,0,1\n1,1,0,east\n")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("row 2") && e.contains("cog_deg") && e.contains("east"),
+        "{e}"
+    );
+    // written and read back, holes included
+    let back = parse(&csv_text(&r)).unwrap();
+    assert_eq!(back.cog.as_ref().unwrap()[0], 359.0);
+    assert!(back.cog.as_ref().unwrap()[1].is_nan());
+    assert!(csv_text(&r).starts_with("t_s,delta_deg,r_degps,u_mps,cog_deg\n"));
+    // resampled through north along the short way (359° → 1° passes 0°, not 180°)
+    let mut g = r.clone();
+    g.cog = Some(vec![359.0, 1.0, 1.0, 1.0]);
+    let h = resample(&g, 0.5, Path::new("f.csv")).unwrap();
+    let mid = h.cog.as_ref().unwrap()[1];
+    assert!(!(1e-9..=360.0 - 1e-9).contains(&mid), "{mid}");
+}
+
+#[test]
 fn missing_column_is_named() {
     let e = parse("t_s,delta_deg\n0,1\n1,1\n").unwrap_err().to_string();
     assert!(e.contains("r_degps") && e.contains("f.csv"), "{e}");

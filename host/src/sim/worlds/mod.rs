@@ -70,6 +70,8 @@ const STREAM_BACKGROUND: u64 = 16;
 const STREAM_GUST: u64 = 17;
 /// Random stream of the sensor drifts.
 const STREAM_SENSORS: u64 = 18;
+/// Random stream of the course-over-ground noise.
+const STREAM_COURSE: u64 = 19;
 /// Gust standard deviation (fraction of the mean wind speed).
 const GUST_STD: f64 = 0.10;
 /// Gust time constant at full scale (s).
@@ -438,6 +440,14 @@ impl Physics {
         (s[0] + uc).hypot(s[1] + vc)
     }
 
+    /// Velocity over ground (north, east; m/s): the hull's through the water plus the
+    /// current.
+    fn ground_velocity(&self, s: &[f64; 6]) -> (f64, f64) {
+        let (sp, cp) = s[5].sin_cos();
+        let (cn, ce) = self.current_ne;
+        (s[0] * cp - s[1] * sp + cn, s[0] * sp + s[1] * cp + ce)
+    }
+
     #[inline]
     fn deriv(&self, hull: &dyn Hull, s: &[f64; 6], delta: f64, w: Weather) -> [f64; 6] {
         let (ua, va) = self.air(s, w);
@@ -454,16 +464,8 @@ impl Physics {
             };
         }
         let a = hull.accel([s[0], s[1], r], delta, [xa, ya, n]);
-        let (sp, cp) = s[5].sin_cos();
-        let (cn, ce) = self.current_ne;
-        [
-            a[0],
-            a[1],
-            a[2],
-            s[0] * cp - s[1] * sp + cn,
-            s[0] * sp + s[1] * cp + ce,
-            r,
-        ]
+        let (vn, ve) = self.ground_velocity(s);
+        [a[0], a[1], a[2], vn, ve, r]
     }
 
     fn rk4(&self, hull: &dyn Hull, s: &mut [f64; 6], delta: f64, dt: f64, w: Weather) {
@@ -687,7 +689,11 @@ fn simulate_hull(
         speed: Some(Vec::with_capacity(n)),
         wind_speed: scenario.log_wind.then(|| Vec::with_capacity(n)),
         wind_angle: scenario.log_wind.then(|| Vec::with_capacity(n)),
+        cog: Some(Vec::with_capacity(n)),
     };
+    // a GPS's velocity noise is isotropic: the speed's `speed_std_mps` across the track
+    // too, so the course errs by that over the speed (own stream: nothing else changes)
+    let mut cr = inputs::rng(seed, STREAM_COURSE);
     let mut nr = inputs::rng(seed, inputs::STREAM_NOISE);
     let ns: NoiseSpec = scenario.noise;
     let mut white = |std: f64| {
@@ -707,6 +713,14 @@ fn simulate_hull(
         push(&mut rec.psi, quantise(heading, sensors.compass_lsb_deg));
         let sn = white(ns.speed_std_mps);
         push(&mut rec.speed, phys.sog(s) + sn);
+        let (vn, ve) = phys.ground_velocity(s);
+        let cross = if ns.speed_std_mps > 0.0 {
+            ns.speed_std_mps * inputs::gauss(&mut cr)
+        } else {
+            0.0
+        };
+        let cog = ve.atan2(vn) + cross / vn.hypot(ve).max(0.1);
+        push(&mut rec.cog, cog.to_degrees().rem_euclid(360.0));
         if scenario.log_wind {
             let (ua, va) = phys.air(s, *w);
             push(&mut rec.wind_speed, ua.hypot(va));

@@ -231,6 +231,70 @@ fn current_carries_the_ship_and_exerts_no_moment() {
 }
 
 #[test]
+fn course_over_ground_is_the_ground_velocity_with_gps_noise() {
+    for kind in NEW {
+        let w = World::new(kind, None).unwrap();
+        let cur = SimEffect::Current {
+            speed_mps: 1.5,
+            towards_deg: 90.0,
+        };
+        let straight = Scenario {
+            input: InputSpec::Constant { delta_deg: 0.0 },
+            effects: vec![cur],
+            ..quiet(300, Vec::new(), &w)
+        };
+        let rec = w.simulate(&straight, 3).unwrap();
+        let (psi, cog) = (rec.psi.as_ref().unwrap(), rec.cog.as_ref().unwrap());
+        // across the heading the ground velocity is the sway plus the current's
+        // 1.5·cos ψ m/s: against the same record without the current, the current's part
+        let calm = w
+            .simulate(
+                &Scenario {
+                    effects: Vec::new(),
+                    ..straight.clone()
+                },
+                3,
+            )
+            .unwrap();
+        let across = |r: &Record, k: usize| {
+            let (s, c, p) = (&r.speed, &r.cog, &r.psi);
+            let (s, c, p) = (
+                s.as_ref().unwrap(),
+                c.as_ref().unwrap(),
+                p.as_ref().unwrap(),
+            );
+            s[k] * (c[k] - p[k]).to_radians().sin()
+        };
+        let worst = (0..rec.len())
+            .map(|k| {
+                let d = across(&rec, k) - across(&calm, k);
+                (d - 1.5 * psi[k].to_radians().cos()).abs()
+            })
+            .fold(0.0, f64::max);
+        println!("{}: worst across error {worst:.3} m/s", kind.name());
+        assert!(worst < 0.1, "{worst}");
+        assert!(cog.iter().all(|c| (0.0..360.0).contains(c)));
+        // the GPS's velocity noise has its own stream: the other channels are unchanged
+        let noisy = Scenario {
+            noise: NoiseSpec {
+                speed_std_mps: 0.05,
+                ..NoiseSpec::none()
+            },
+            ..straight.clone()
+        };
+        let a = w.simulate(&noisy, 3).unwrap();
+        assert_eq!(a.psi, rec.psi);
+        assert_eq!(a.y, rec.y);
+        let dc: Vec<f64> = (0..a.len())
+            .map(|k| (a.cog.as_ref().unwrap()[k] - cog[k] + 180.0).rem_euclid(360.0) - 180.0)
+            .collect();
+        // 0.05 m/s across at ≈ 8 m/s: ≈ 0.36° of course
+        let sd = (dc.iter().map(|d| d * d).sum::<f64>() / dc.len() as f64).sqrt();
+        assert!(sd > 0.2 && sd < 0.6, "{sd}");
+    }
+}
+
+#[test]
 fn wind_moment_follows_the_blendermann_curve() {
     let w = World::new(WorldKind::Kvlcc2, None).unwrap();
     let h = w.hull().unwrap();
