@@ -14,6 +14,8 @@
 #                     two-effect case is written a+b (e.g. rate-limit+wind): it is right when
 #                     the ranked verdict (`verdict`, then `then`) names both
 #   --jobs J          cases run at once (default 2)
+#   --log-wind        every record (reference and trials) logs the anemometer's apparent
+#                     wind (`simulate --log-wind`); without it, none does
 #
 # Per world: the reference is 3 records of the world's identification input (seeds 900–902,
 # gyro noise 0.02 °/s, heading noise 0.1°) and the model identified on them; each case is 3
@@ -32,6 +34,7 @@ seeds=3
 strengths="1,0.5"
 effects="none,bias,gyro-bias,dead-time,rate-limit,saturation,asymmetry,nonlinear-damping,wind,current,dead-band"
 jobs=2
+logwind=""
 while [ $# -gt 0 ]; do
     case "$1" in
         --yawcast) yawcast="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
@@ -41,7 +44,8 @@ while [ $# -gt 0 ]; do
         --strengths) strengths="$2"; shift 2 ;;
         --effects) effects="$2"; shift 2 ;;
         --jobs) jobs="$2"; shift 2 ;;
-        -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
+        --log-wind) logwind="--log-wind"; shift ;;
+        -h|--help) sed -n '2,26p' "$0"; exit 0 ;;
         *) echo "unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
@@ -50,7 +54,7 @@ if [ -z "$yawcast" ]; then
     yawcast="${CARGO_TARGET_DIR:-$repo/target}/ci/yawcast"
 fi
 mkdir -p "$work"
-export YAWCAST="$yawcast" WORK="$work"
+export YAWCAST="$yawcast" WORK="$work" LOGWIND="$logwind"
 
 # one case: world effect strength seed → a line
 # "world<TAB>strength<TAB>effect<TAB>seed<TAB>verdict<TAB>then"
@@ -65,7 +69,7 @@ case_run() {
         eff+=(--strength "$strength")
     fi
     "$YAWCAST" simulate --world "$world" "${eff[@]}" --records 3 --seed $((100 * seed)) \
-        --gyro-noise 0.03 --heading-noise 0.2 --speed-noise 0.02 \
+        --gyro-noise 0.03 --heading-noise 0.2 --speed-noise 0.02 $LOGWIND \
         --out "$dir/trial.csv" >"$dir/simulate.log" 2>&1
     local refs=()
     for i in 1 2 3; do refs+=(--reference "$WORK/$world/ref-$i.csv"); done
@@ -96,7 +100,7 @@ for w in "${world_list[@]}"; do
     mkdir -p "$work/$w"
     if [ ! -f "$work/$w/ref.postcard" ]; then
         "$yawcast" simulate --world "$w" --records 3 --seed 900 --gyro-noise 0.02 \
-            --heading-noise 0.1 --out "$work/$w/ref.csv" >"$work/$w/ref.log" 2>&1
+            --heading-noise 0.1 $logwind --out "$work/$w/ref.csv" >"$work/$w/ref.log" 2>&1
         "$yawcast" identify --data "$work/$w/ref-1.csv" --data "$work/$w/ref-2.csv" \
             --data "$work/$w/ref-3.csv" --out "$work/$w/ref" >>"$work/$w/ref.log" 2>&1
     fi

@@ -377,8 +377,7 @@ pub fn diagnose(
         .iter()
         .enumerate()
         .map(|(i, &kind)| {
-            let mut e =
-                effect_evidence(base, kind, &real[i], &nulls[i], has_ref, cfg, ch.hb, ch.sog);
+            let mut e = effect_evidence(base, kind, &real[i], &nulls[i], has_ref, cfg, &ch);
             if let Some(own) = base.effect(kind).filter(|_| gear.is_some()) {
                 e.words.push_str(&format!(
                     " (the reference's own: {})",
@@ -390,7 +389,17 @@ pub fn diagnose(
         .collect();
     let mut ev = evidence;
     let level = cfg.alpha / cfg_m(cfg);
-    rank(base, &trial, &mut ev, &grids, level, cfg, ch.sog.is_some());
+    let anemometer = ch.anemometer.map(|a| a.p);
+    rank(
+        base,
+        &trial,
+        &mut ev,
+        &grids,
+        level,
+        cfg,
+        ch.sog.is_some(),
+        anemometer,
+    );
 
     // materiality: the effect's own held-out contribution (θ frozen, the effect's gains
     // refitted on the estimation part), best first; the verdict's effect is then refitted

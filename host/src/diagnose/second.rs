@@ -56,11 +56,7 @@ pub(super) fn second_effect(
     let mut ev: Vec<Evidence> = keep
         .iter()
         .zip(&stats)
-        .map(|(&i, st)| {
-            effect_evidence(
-                with_first, grids[i].0, st, &nulls[i], has_ref, cfg, ch.hb, ch.sog,
-            )
-        })
+        .map(|(&i, st)| effect_evidence(with_first, grids[i].0, st, &nulls[i], has_ref, cfg, ch))
         .collect();
     // the first stage's ranking, on the model with the first effect; then the first
     // significant effect that improves held-out prediction by the ranking rule's GAIN_PP
@@ -77,6 +73,7 @@ pub(super) fn second_effect(
         level,
         cfg,
         ch.sog.is_some(),
+        ch.anemometer.map(|a| a.p),
     );
     let before = mean_fit(with_first, held.1, &Horizon::REPORT);
     let est_set = Set::new(with_first, held.0);

@@ -239,6 +239,16 @@ fn world_records(
     effects: Vec<SimEffect>,
     seeds: &[u64],
 ) -> Vec<Record> {
+    world_records_with(kind, effects, seeds, false)
+}
+
+/// [`world_records`], with the anemometer's columns logged or not.
+fn world_records_with(
+    kind: crate::sim::WorldKind,
+    effects: Vec<SimEffect>,
+    seeds: &[u64],
+    log_wind: bool,
+) -> Vec<Record> {
     let w = crate::sim::World::new(kind, None).unwrap();
     let sc = Scenario {
         n_samples: 1800,
@@ -249,9 +259,54 @@ fn world_records(
             speed_std_mps: 0.02,
         },
         effects,
+        log_wind,
         ..Scenario::default()
     };
     w.simulate_many(&sc, seeds).unwrap()
+}
+
+#[test]
+fn the_anemometer_shows_wind_and_not_a_current() {
+    // Mariner at half the canonical wind: its yaw moment is too weak for the yaw channel
+    // and its leeway moves the ground track like a current. The anemometer's apparent
+    // wind with the ground velocity gives the true wind itself; a current carries ship
+    // and anemometer alike and leaves none
+    use super::channels::anemometer_evidence;
+    use crate::sim::{World, WorldKind};
+    let k = WorldKind::Mariner;
+    let w = World::new(k, None).unwrap();
+    let hidden = w.hidden(EffectKind::Wind, 0.5);
+    let SimEffect::Wind {
+        speed_mps,
+        from_deg,
+    } = hidden
+    else {
+        panic!("{hidden:?}")
+    };
+    let reference = world_records_with(k, Vec::new(), &[900, 901, 902], true);
+    let wind = world_records_with(k, vec![hidden], &[101, 102, 103], true);
+    let a = anemometer_evidence(&wind, &reference).unwrap();
+    let (speed, from) = a.speed_from();
+    println!("true wind {speed:.2} m/s from {from:.0}° (hidden {speed_mps:.2}, {from_deg}); {a:?}");
+    // the gusts multiply the mean wind by 1 + g, g of mean zero
+    assert!((speed - speed_mps).abs() < 0.05 * speed_mps, "{speed}");
+    assert!((from - from_deg).abs() < 3.0, "{from}");
+    assert!(a.p < 1e-12, "{a:?}");
+    let level = 0.01 / 10.0;
+    for (what, effects) in [
+        ("a current", vec![w.hidden(EffectKind::Current, 1.0)]),
+        ("nothing", Vec::new()),
+    ] {
+        let t = world_records_with(k, effects, &[201, 202, 203], true);
+        let a = anemometer_evidence(&t, &reference).unwrap();
+        println!("{what}: {:?}, p = {:.3}", a.speed_from(), a.p);
+        assert!(a.p > level && a.speed_from().0 < 0.1, "{what}: {a:?}");
+    }
+    // without the columns, or without a course, no anemometer evidence
+    assert!(anemometer_evidence(&world_records(k, Vec::new(), &[5]), &[]).is_none());
+    let mut no_course = wind.clone();
+    no_course[0].cog = None;
+    assert!(anemometer_evidence(&no_course, &reference).is_none());
 }
 
 #[test]
@@ -625,7 +680,7 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
         evidence(EffectKind::Bias, 1e-4, 1e-4, false),
         evidence(EffectKind::Wind, 2e-3, 4e-4, false),
     ];
-    current_or_wind(&mut ev, level, alpha, true);
+    current_or_wind(&mut ev, level, alpha, true, None);
     assert_eq!(
         kinds(&ev),
         [EffectKind::Wind, EffectKind::Current, EffectKind::Bias]
@@ -638,7 +693,7 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
         evidence(EffectKind::Wind, 1e-6, 0.3, true),
         evidence(EffectKind::Current, 1e-7, 0.05, true),
     ];
-    current_or_wind(&mut ev, level, alpha, true);
+    current_or_wind(&mut ev, level, alpha, true, None);
     assert_eq!(kinds(&ev), [EffectKind::Current, EffectKind::Wind]);
     assert_eq!(ev[1].p, 1e-6);
     // without speed over ground, or with neither significant, nothing changes
@@ -647,7 +702,7 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
             evidence(EffectKind::Current, p, 1e-9, true),
             evidence(EffectKind::Wind, p, 1e-9, true),
         ];
-        current_or_wind(&mut ev, level, alpha, speed);
+        current_or_wind(&mut ev, level, alpha, speed, None);
         assert_eq!(kinds(&ev), [EffectKind::Current, EffectKind::Wind]);
         assert_eq!(ev[1].p, p);
     }

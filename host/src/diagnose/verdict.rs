@@ -9,7 +9,7 @@ use serde::Serialize;
 use yawcast_shared::model::EffectKind;
 
 use super::augment::AugmentReport;
-use super::channels::{add_channels, Channels, SogEvidence};
+use super::channels::{add_channels, Channels};
 use super::compare::mean_fit;
 use super::evidence::{effect_with, horizon_of, Quad, Set, WorldStat};
 use super::null::Null;
@@ -56,8 +56,7 @@ pub(super) fn effect_evidence(
     null_reps: &[f64],
     has_ref: bool,
     cfg: &DiagnoseConfig,
-    hb: Option<(f64, f64)>,
-    sog: Option<SogEvidence>,
+    ch: &Channels,
 ) -> Evidence {
     let ts = model.ts;
     let h = horizon_of(kind);
@@ -83,7 +82,7 @@ pub(super) fn effect_evidence(
     };
     let pct = 100.0 * (1.0 - (-d / tn.max(1) as f64).exp());
     yaw_words(&mut ev, ts, pct);
-    add_channels(&mut ev, has_ref, cfg, hb, sog);
+    add_channels(&mut ev, has_ref, cfg, ch);
     ev
 }
 
@@ -107,6 +106,7 @@ pub(super) fn rank(
     level: f64,
     cfg: &DiagnoseConfig,
     speed: bool,
+    anemometer: Option<f64>,
 ) {
     ev.sort_by(|a, b| {
         let key = |e: &Evidence| ((e.p < level) as u8, e.channel_material as u8);
@@ -116,7 +116,7 @@ pub(super) fn rank(
                 .unwrap_or(std::cmp::Ordering::Equal),
         )
     });
-    current_or_wind(ev, level, cfg.alpha, speed);
+    current_or_wind(ev, level, cfg.alpha, speed, anemometer);
     encompass(
         base,
         trial,
@@ -231,7 +231,13 @@ pub(super) fn gain_before_statistic(
 /// both the heading dependence (the better of the two effects' p-values) and the yaw moment
 /// are (intersection–union: the larger p-value), and material when the speed channel shows
 /// the heading dependence.
-pub(super) fn current_or_wind(ev: &mut Vec<Evidence>, level: f64, alpha: f64, speed: bool) {
+pub(super) fn current_or_wind(
+    ev: &mut Vec<Evidence>,
+    level: f64,
+    alpha: f64,
+    speed: bool,
+    anemometer: Option<f64>,
+) {
     let pos = |ev: &[Evidence], k: EffectKind| ev.iter().position(|e| e.kind == k);
     let (Some(ic), Some(iw)) = (pos(ev, EffectKind::Current), pos(ev, EffectKind::Wind)) else {
         return;
@@ -240,17 +246,33 @@ pub(super) fn current_or_wind(ev: &mut Vec<Evidence>, level: f64, alpha: f64, sp
         return;
     }
     let p_moment = (2.0 * ev[ic].p_yaw.min(ev[iw].p_yaw)).min(1.0);
-    let wind = p_moment < alpha;
-    let words = format!(
-        "; yaw moment varying with heading: p {} ({}): {}",
-        fmt_p(p_moment),
-        if wind { "present" } else { "absent" },
-        if wind {
-            "the ship is turned by it, wind (a current carries the ship without turning it)"
-        } else {
-            "speed over ground alone depends on heading, the water carries the ship: a current"
-        }
-    );
+    // an anemometer measures the wind itself: it decides, the yaw moment does not
+    let (p_decide, wind) = match anemometer {
+        Some(p) => (p, p < alpha),
+        None => (p_moment, p_moment < alpha),
+    };
+    let words = match anemometer {
+        Some(_) => format!(
+            "; true wind on the anemometer: p {} ({}): {}",
+            fmt_p(p_decide),
+            if wind { "present" } else { "absent" },
+            if wind {
+                "the ground track moves with the wind: wind"
+            } else {
+                "no wind moves it, the water carries the ship: a current"
+            }
+        ),
+        None => format!(
+            "; yaw moment varying with heading: p {} ({}): {}",
+            fmt_p(p_moment),
+            if wind { "present" } else { "absent" },
+            if wind {
+                "the ship is turned by it, wind (a current carries the ship without turning it)"
+            } else {
+                "speed over ground alone depends on heading, the water carries the ship: a current"
+            }
+        ),
+    };
     ev[ic].words.push_str(&words);
     ev[iw].words.push_str(&words);
     ev[ic].speed_only = !wind;
@@ -259,7 +281,7 @@ pub(super) fn current_or_wind(ev: &mut Vec<Evidence>, level: f64, alpha: f64, sp
         let heading_p = ev[ic].p.min(ev[iw].p);
         let cm = ev[ic].channel_material;
         let w = &mut ev[iw];
-        w.p = w.p.min(heading_p.max(p_moment));
+        w.p = w.p.min(heading_p.max(p_decide));
         w.channel_material |= cm;
     }
     let (win, lose) = if wind { (iw, ic) } else { (ic, iw) };
