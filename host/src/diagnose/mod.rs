@@ -389,17 +389,7 @@ pub fn diagnose(
         .collect();
     let mut ev = evidence;
     let level = cfg.alpha / cfg_m(cfg);
-    let anemometer = ch.anemometer.map(|a| a.p);
-    rank(
-        base,
-        &trial,
-        &mut ev,
-        &grids,
-        level,
-        cfg,
-        ch.sog.is_some(),
-        anemometer,
-    );
+    rank(base, &trial, &mut ev, &grids, level, cfg, &ch);
 
     // materiality: the effect's own held-out contribution (θ frozen, the effect's gains
     // refitted on the estimation part), best first; the verdict's effect is then refitted

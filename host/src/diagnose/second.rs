@@ -65,16 +65,7 @@ pub(super) fn second_effect(
     // channel shows with nothing in the yaw rate to gain (a gyro offset from the heading, a
     // current from speed over ground alone)
     let trial = Set::new(with_first, est);
-    rank(
-        with_first,
-        &trial,
-        &mut ev,
-        &rest,
-        level,
-        cfg,
-        ch.sog.is_some(),
-        ch.anemometer.map(|a| a.p),
-    );
+    rank(with_first, &trial, &mut ev, &rest, level, cfg, ch);
     let before = mean_fit(with_first, held.1, &Horizon::REPORT);
     let est_set = Set::new(with_first, held.0);
     let pick = ev.iter().position(|e| {

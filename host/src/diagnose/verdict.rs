@@ -105,9 +105,10 @@ pub(super) fn rank(
     grids: &[(EffectKind, Vec<Effect>)],
     level: f64,
     cfg: &DiagnoseConfig,
-    speed: bool,
-    anemometer: Option<f64>,
+    ch: &Channels,
 ) {
+    let speed = ch.sog.is_some();
+    let anemometer = ch.anemometer.map(|a| a.p);
     ev.sort_by(|a, b| {
         let key = |e: &Evidence| ((e.p < level) as u8, e.channel_material as u8);
         key(b).cmp(&key(a)).then(
