@@ -179,8 +179,21 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
             // a GPS drop-out leaves the course empty (or NaN): missing, not an error
             let s = row.get(i).unwrap_or("");
             let missing = s.is_empty() || s.eq_ignore_ascii_case("nan");
-            // degrees whatever --angle-unit says, as the navigation reader takes it
-            v.push(if missing { f64::NAN } else { cell(i)? });
+            // degrees whatever --angle-unit says, as the navigation reader takes it (and
+            // with its words for a cell that is not a number)
+            let c = if missing {
+                f64::NAN
+            } else {
+                cell(i).map_err(|_| DataError::Csv {
+                    path: path.to_path_buf(),
+                    message: format!(
+                        "row {rown}, column `{}`: expected a number (or an empty cell), \
+                         found `{s}`",
+                        headers[i]
+                    ),
+                })?
+            };
+            v.push(c);
         }
     }
     if rec.t.len() < 2 {
