@@ -53,7 +53,7 @@ fn kvlcc2_writes_the_usual_columns_seeded() {
     let mut lines = a.lines();
     assert_eq!(
         lines.next().unwrap(),
-        "t_s,delta_deg,r_degps,psi_deg,u_mps,wind_speed_mps,wind_angle_deg"
+        "t_s,delta_deg,r_degps,psi_deg,u_mps,wind_speed_mps,wind_angle_deg,cog_deg"
     );
     let rows: Vec<Vec<f64>> = lines
         .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
@@ -95,7 +95,7 @@ fn kvlcc2_writes_the_usual_columns_seeded() {
     assert_eq!(summary["world"], "mariner");
     assert_eq!(summary["ship"], "Mariner (Abkowitz, Lpp 160.93 m)");
     assert_eq!(summary["records"][0]["samples"], 120);
-    assert!(mar.starts_with("t_s,delta_deg,r_degps,psi_deg,u_mps\n"));
+    assert!(mar.starts_with("t_s,delta_deg,r_degps,psi_deg,u_mps,cog_deg\n"));
     let _ = std::fs::remove_dir_all(&d);
 }
 
