@@ -137,12 +137,15 @@ pub(super) fn anemometer_evidence(
     reference: &[Record],
 ) -> Option<AnemometerEvidence> {
     let stat = |recs: &[Record]| -> Option<[(f64, f64); 2]> {
-        let w: Vec<[Vec<f64>; 2]> = recs.iter().map(true_wind).collect::<Option<_>>()?;
-        let comp = |k: usize| {
-            let series: Vec<Vec<f64>> = w.iter().map(|x| x[k].clone()).collect();
-            block_mean(&series).map(|(m, se, _)| (m, se))
-        };
-        Some([comp(0)?, comp(1)?])
+        let (mut north, mut east) = (Vec::new(), Vec::new());
+        for r in recs {
+            let [n, e] = true_wind(r)?;
+            north.push(n);
+            east.push(e);
+        }
+        let (mn, sn, _) = block_mean(&north)?;
+        let (me, se, _) = block_mean(&east)?;
+        Some([(mn, sn), (me, se)])
     };
     let t = stat(trial)?;
     let r = if reference.is_empty() {
@@ -257,12 +260,10 @@ fn sog_harmonics(
                 }
             };
             if let Some(b) = remove {
-                let p0 = psi[t].to_radians();
-                let h0 = [p0.sin(), p0.cos(), (2.0 * p0).sin(), (2.0 * p0).cos()];
+                let h0 = harmonics(psi[t]);
                 target -= (0..4).map(|j| h0[j] * b[j]).sum::<f64>();
             }
-            let ph = psi[(t + sh) % n].to_radians();
-            let h = [ph.sin(), ph.cos(), (2.0 * ph).sin(), (2.0 * ph).cos()];
+            let h = harmonics(psi[(t + sh) % n]);
             x.fill(0.0);
             x[i] = 1.0;
             for (j, hj) in h.iter().enumerate() {
@@ -292,6 +293,12 @@ fn sog_harmonics(
     }
     let beta = xtx.cholesky()?.solve(&xty);
     Some(beta.rows(nr, 4).into_owned())
+}
+
+/// The heading harmonics (sin ψ, cos ψ, sin 2ψ, cos 2ψ) of a heading in degrees.
+fn harmonics(psi_deg: f64) -> [f64; 4] {
+    let ph = psi_deg.to_radians();
+    [ph.sin(), ph.cos(), (2.0 * ph).sin(), (2.0 * ph).cos()]
 }
 
 /// Time constants (s) of the low-pass nuisance regressors of speed over ground: a surge
@@ -328,16 +335,17 @@ const SOG_SHIFTS: usize = 60;
 
 /// Covariance of the harmonics under "no heading dependence": heading circularly shifted
 /// against speed by random amounts (10–90 % of each record), which keeps both series'
-/// own structure. The heading dependence the records show is taken out first: a strong
+/// own structure. The heading dependence the records show (`own`, their harmonics as
+/// [`sog_harmonics`] gives them unshifted) is taken out first: a strong
 /// one (a current of a knot) is itself a slow series, and shifted against the heading it
 /// would pass for noise and hide itself.
 fn sog_null_cov(
     lane: Lane,
     recs: &[&Record],
     taus: &[f64],
+    own: &DVector<f64>,
     rng: &mut ChaCha8Rng,
 ) -> Option<DMatrix<f64>> {
-    let own = sog_harmonics(lane, recs, &[], taus, None)?;
     let mut draws = Vec::with_capacity(SOG_SHIFTS);
     for _ in 0..SOG_SHIFTS {
         let sh: Vec<usize> = recs
@@ -347,7 +355,7 @@ fn sog_null_cov(
                 rng.random_range(n / 10..=(9 * n / 10).max(n / 10 + 1))
             })
             .collect();
-        draws.push(sog_harmonics(lane, recs, &sh, taus, Some(&own))?);
+        draws.push(sog_harmonics(lane, recs, &sh, taus, Some(own))?);
     }
     let m = draws.len() as f64;
     let mean = draws.iter().fold(DVector::zeros(4), |a, b| a + b) / m;
@@ -511,12 +519,12 @@ fn sog_difference(
     rng: &mut ChaCha8Rng,
 ) -> Option<(DVector<f64>, DMatrix<f64>)> {
     let t = sog_harmonics(lane, trial, &[], taus, None)?;
-    let vt = sog_null_cov(lane, trial, taus, rng)?;
+    let vt = sog_null_cov(lane, trial, taus, &t, rng)?;
     if reference.is_empty() {
         return Some((t, vt));
     }
     let r = sog_harmonics(lane, reference, &[], taus, None)?;
-    let vr = sog_null_cov(lane, reference, taus, rng)?;
+    let vr = sog_null_cov(lane, reference, taus, &r, rng)?;
     Some((t - r, vt + vr))
 }
 
@@ -671,9 +679,11 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
             }
         }
         Channel::SpeedOverGround => {
+            let mut p_speed = None;
             if let Some(s) = sog {
                 let current = kind == EffectKind::Current;
                 let (chi, df, p_sog) = s.test(current);
+                p_speed = Some(p_sog);
                 let calibration = s.calibration_words(current);
                 // either channel may show it (Bonferroni over the two)
                 ev.p = (2.0 * p_yaw.min(p_sog)).min(1.0);
@@ -724,7 +734,7 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
             if let (EffectKind::Wind, Some(a)) = (kind, ch.anemometer) {
                 // the direct channel: three tests now, Bonferroni over them
                 let (speed, from) = a.speed_from();
-                let p_sog = if sog.is_some() { ev.p / 2.0 } else { p_yaw };
+                let p_sog = p_speed.unwrap_or(p_yaw);
                 ev.p = (3.0 * p_yaw.min(a.p).min(p_sog)).min(1.0);
                 ev.score = ev.score.max(a.chi - 2.0);
                 ev.channel_material |= a.p < cfg.alpha / cfg_m(cfg);

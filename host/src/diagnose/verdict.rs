@@ -252,28 +252,24 @@ pub(super) fn current_or_wind(
         Some(p) => (p, p < alpha),
         None => (p_moment, p_moment < alpha),
     };
-    let words = match anemometer {
-        Some(_) => format!(
-            "; true wind on the anemometer: p {} ({}): {}",
-            fmt_p(p_decide),
-            if wind { "present" } else { "absent" },
-            if wind {
-                "the ground track moves with the wind: wind"
-            } else {
-                "no wind moves it, the water carries the ship: a current"
-            }
+    let (witness, turned, carried) = match anemometer {
+        Some(_) => (
+            "true wind on the anemometer",
+            "the ground track moves with the wind: wind",
+            "no wind moves it, the water carries the ship: a current",
         ),
-        None => format!(
-            "; yaw moment varying with heading: p {} ({}): {}",
-            fmt_p(p_moment),
-            if wind { "present" } else { "absent" },
-            if wind {
-                "the ship is turned by it, wind (a current carries the ship without turning it)"
-            } else {
-                "speed over ground alone depends on heading, the water carries the ship: a current"
-            }
+        None => (
+            "yaw moment varying with heading",
+            "the ship is turned by it, wind (a current carries the ship without turning it)",
+            "speed over ground alone depends on heading, the water carries the ship: a current",
         ),
     };
+    let words = format!(
+        "; {witness}: p {} ({}): {}",
+        fmt_p(p_decide),
+        if wind { "present" } else { "absent" },
+        if wind { turned } else { carried }
+    );
     ev[ic].words.push_str(&words);
     ev[iw].words.push_str(&words);
     ev[ic].speed_only = !wind;
