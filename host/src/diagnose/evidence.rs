@@ -332,42 +332,60 @@ pub(super) fn world(
     grids: &[(EffectKind, Vec<Effect>)],
     parallel: bool,
 ) -> Vec<WorldStat> {
-    world_with(model, model, reference, trial, grids, parallel)
+    let versions = reference_versions(model, reference, grids, parallel);
+    trial_stats(model, trial, grids, &versions, parallel)
 }
 
-/// [`world`] with the trials measured against `on_trial` (the model with an effect the
-/// trials show added) and the reference versions found against `model`.
-pub(super) fn world_with(
+/// The version of each effect of `grids` the `reference` records show against `model` (the
+/// model itself for every effect when there are none).
+pub(super) fn reference_versions(
     model: &Model,
-    on_trial: &Model,
     reference: &[Record],
-    trial: &[Record],
     grids: &[(EffectKind, Vec<Effect>)],
     parallel: bool,
-) -> Vec<WorldStat> {
-    let tset = Set::new(on_trial, trial);
+) -> Vec<Version> {
+    if reference.is_empty() {
+        let none = Version {
+            idx: None,
+            beta: DVector::zeros(0),
+        };
+        return vec![none; grids.len()];
+    }
     let rset = Set::new(model, reference);
-    let one = |(kind, cands): &(EffectKind, Vec<Effect>)| {
-        let h = horizon_of(*kind);
-        let (t0, tn) = tset.sse0(on_trial, h);
-        let tq = tset.family(on_trial, cands, h, false);
-        let version = if reference.is_empty() {
-            Version {
-                idx: None,
-                beta: DVector::zeros(0),
-            }
-        } else {
+    crate::par::map(
+        grids,
+        parallel,
+        |(kind, cands): &(EffectKind, Vec<Effect>)| {
+            let h = horizon_of(*kind);
             let (r0, _) = rset.sse0(model, h);
             let rq = rset.family(model, cands, h, false);
             version_of(&rq, r0)
-        };
-        let (d, bi, bb) = trial_statistic(&tq, t0, tn, &version);
+        },
+    )
+}
+
+/// The statistic `D` of every kind of `grids` on `trial` against `on_trial` (the model, or
+/// the model with an effect the trials show added), measured from `versions[i]`, the version
+/// of `grids[i]` the reference shows ([`reference_versions`]).
+pub(super) fn trial_stats(
+    on_trial: &Model,
+    trial: &[Record],
+    grids: &[(EffectKind, Vec<Effect>)],
+    versions: &[Version],
+    parallel: bool,
+) -> Vec<WorldStat> {
+    let tset = Set::new(on_trial, trial);
+    let items: Vec<_> = grids.iter().zip(versions).collect();
+    crate::par::map(&items, parallel, |&((kind, cands), version)| {
+        let h = horizon_of(*kind);
+        let (t0, tn) = tset.sse0(on_trial, h);
+        let tq = tset.family(on_trial, cands, h, false);
+        let (d, bi, bb) = trial_statistic(&tq, t0, tn, version);
         WorldStat {
             d,
             best: effect_with(&cands[bi], &bb),
             n: tn,
             reference: version.idx.map(|i| effect_with(&cands[i], &version.beta)),
         }
-    };
-    crate::par::map(grids, parallel, one)
+    })
 }

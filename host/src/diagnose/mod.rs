@@ -100,7 +100,7 @@ use crate::identify::pem::offset::OFFSET_KINDS;
 use crate::identify::predict::Horizon;
 use crate::io::data::Record;
 use channels::Channels;
-use evidence::{grid, world, Set};
+use evidence::{grid, reference_versions, trial_stats, Set};
 use null::bootstrap;
 use reference::{foreign, reference_actuator};
 use verdict::{
@@ -358,7 +358,8 @@ pub fn diagnose(
 
     let grids: Vec<(EffectKind, Vec<Effect>)> =
         kinds.iter().map(|&k| (k, grid(k, &span))).collect();
-    let real = world(base, reference, est, &grids, cfg.parallel);
+    let versions = reference_versions(base, reference, &grids, cfg.parallel);
+    let real = trial_stats(base, est, &grids, &versions, cfg.parallel);
     bar.inc(1);
     bar.set_message("bootstrap replicates");
     let nulls = bootstrap(
@@ -460,7 +461,7 @@ pub fn diagnose(
         second::second_effect(
             base,
             &first.best,
-            reference,
+            &versions,
             est,
             &grids,
             &nulls,

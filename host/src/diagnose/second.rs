@@ -5,7 +5,7 @@ use yawcast_shared::model::EffectKind;
 
 use super::channels::Channels;
 use super::compare::mean_fit;
-use super::evidence::{world_with, Set};
+use super::evidence::{trial_stats, Set, Version};
 use super::verdict::{effect_evidence, frozen_gain, rank, Evidence, GAIN_PP};
 use super::DiagnoseConfig;
 use crate::effects::{def, Channel};
@@ -15,8 +15,8 @@ use crate::io::data::Record;
 
 /// What the trials show beside the verdict's effect `first`: each other effect's statistic
 /// `D` measured on the trials against the model with `first` (its trial version, θ frozen as
-/// in the first stage), the reference versions still found against
-/// `base` (the reference lacks `first`), judged against the first stage's null replicates
+/// in the first stage), from the first stage's reference versions (`versions[i]` for
+/// `grids[i]`, found against `base`: the reference lacks `first`), judged against the first stage's null replicates
 /// (`nulls[i]` for `grids[i]`: the null of an effect's statistic depends on its grid and the
 /// records, not on what else the model carries). Current and wind share speed over ground's
 /// evidence, so beside either the other is not a second effect. The others are ranked by the
@@ -30,7 +30,7 @@ use crate::io::data::Record;
 pub(super) fn second_effect(
     base: &Model,
     first: &Effect,
-    reference: &[Record],
+    versions: &[Version],
     est: &[Record],
     grids: &[(EffectKind, Vec<Effect>)],
     nulls: &[Vec<f64>],
@@ -52,7 +52,8 @@ pub(super) fn second_effect(
         .filter(|&i| grids[i].0 != k1 && !shares_speed(grids[i].0))
         .collect();
     let rest: Vec<(EffectKind, Vec<Effect>)> = keep.iter().map(|&i| grids[i].clone()).collect();
-    let stats = world_with(base, with_first, reference, est, &rest, cfg.parallel);
+    let kept: Vec<Version> = keep.iter().map(|&i| versions[i].clone()).collect();
+    let stats = trial_stats(with_first, est, &rest, &kept, cfg.parallel);
     let mut ev: Vec<Evidence> = keep
         .iter()
         .zip(&stats)
