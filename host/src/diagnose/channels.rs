@@ -206,10 +206,12 @@ const CROSS_MIN_SPEED: f64 = 0.1;
 /// velocity; nuisance: one intercept per record and the lane's own regressors (see
 /// [`Lane`]). `shift[i]` circularly shifts record i's heading against its speed (0: aligned);
 /// `remove` is a heading dependence (coefficients as returned) taken out of the target at the
-/// true heading first, as the null draws do.
+/// true heading first, as the null draws do. `harm[i]` are record i's [`heading_harmonics`]
+/// (computed once for the many shifted draws of one set).
 fn sog_harmonics(
     lane: Lane,
     recs: &[&Record],
+    harm: &[Vec<[f64; 4]>],
     shift: &[usize],
     taus: &[f64],
     remove: Option<&DVector<f64>>,
@@ -229,7 +231,7 @@ fn sog_harmonics(
     let mut xty = DVector::<f64>::zeros(p);
     let mut x = DVector::<f64>::zeros(p);
     let mut rows = 0usize;
-    for (i, r) in recs.iter().enumerate() {
+    for ((i, r), hr) in recs.iter().enumerate().zip(harm) {
         let psi = r.psi.as_ref()?;
         let sp = r.speed.as_ref()?;
         let cog = match lane {
@@ -260,10 +262,10 @@ fn sog_harmonics(
                 }
             };
             if let Some(b) = remove {
-                let h0 = harmonics(psi[t]);
+                let h0 = &hr[t];
                 target -= (0..4).map(|j| h0[j] * b[j]).sum::<f64>();
             }
-            let h = harmonics(psi[(t + sh) % n]);
+            let h = &hr[(t + sh) % n];
             x.fill(0.0);
             x[i] = 1.0;
             for (j, hj) in h.iter().enumerate() {
@@ -295,10 +297,22 @@ fn sog_harmonics(
     Some(beta.rows(nr, 4).into_owned())
 }
 
-/// The heading harmonics (sin ψ, cos ψ, sin 2ψ, cos 2ψ) of a heading in degrees.
-fn harmonics(psi_deg: f64) -> [f64; 4] {
-    let ph = psi_deg.to_radians();
-    [ph.sin(), ph.cos(), (2.0 * ph).sin(), (2.0 * ph).cos()]
+/// The heading harmonics (sin ψ, cos ψ, sin 2ψ, cos 2ψ) of every sample of every record;
+/// `None` when a record has no heading.
+fn heading_harmonics(recs: &[&Record]) -> Option<Vec<Vec<[f64; 4]>>> {
+    recs.iter()
+        .map(|r| {
+            let psi = r.psi.as_ref()?;
+            Some(
+                psi.iter()
+                    .map(|p| {
+                        let ph = p.to_radians();
+                        [ph.sin(), ph.cos(), (2.0 * ph).sin(), (2.0 * ph).cos()]
+                    })
+                    .collect(),
+            )
+        })
+        .collect()
 }
 
 /// Time constants (s) of the low-pass nuisance regressors of speed over ground: a surge
@@ -342,6 +356,7 @@ const SOG_SHIFTS: usize = 60;
 fn sog_null_cov(
     lane: Lane,
     recs: &[&Record],
+    harm: &[Vec<[f64; 4]>],
     taus: &[f64],
     own: &DVector<f64>,
     rng: &mut ChaCha8Rng,
@@ -355,7 +370,7 @@ fn sog_null_cov(
                 rng.random_range(n / 10..=(9 * n / 10).max(n / 10 + 1))
             })
             .collect();
-        draws.push(sog_harmonics(lane, recs, &sh, taus, Some(own))?);
+        draws.push(sog_harmonics(lane, recs, harm, &sh, taus, Some(own))?);
     }
     let m = draws.len() as f64;
     let mean = draws.iter().fold(DVector::zeros(4), |a, b| a + b) / m;
@@ -518,13 +533,15 @@ fn sog_difference(
     taus: &[f64],
     rng: &mut ChaCha8Rng,
 ) -> Option<(DVector<f64>, DMatrix<f64>)> {
-    let t = sog_harmonics(lane, trial, &[], taus, None)?;
-    let vt = sog_null_cov(lane, trial, taus, &t, rng)?;
+    let ht = heading_harmonics(trial)?;
+    let t = sog_harmonics(lane, trial, &ht, &[], taus, None)?;
+    let vt = sog_null_cov(lane, trial, &ht, taus, &t, rng)?;
     if reference.is_empty() {
         return Some((t, vt));
     }
-    let r = sog_harmonics(lane, reference, &[], taus, None)?;
-    let vr = sog_null_cov(lane, reference, taus, &r, rng)?;
+    let hr = heading_harmonics(reference)?;
+    let r = sog_harmonics(lane, reference, &hr, &[], taus, None)?;
+    let vr = sog_null_cov(lane, reference, &hr, taus, &r, rng)?;
     Some((t - r, vt + vr))
 }
 
