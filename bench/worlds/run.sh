@@ -3,7 +3,8 @@
 # simulator world (`simulate --world`), with an independent effect-free reference per world.
 #
 #   bench/worlds/run.sh [--yawcast PATH] [--work DIR] [--worlds LIST] [--seeds N]
-#                       [--strengths LIST] [--effects LIST] [--jobs J]
+#                       [--strengths LIST] [--effects LIST] [--jobs J] [--log-wind]
+#                       [--augment]
 #
 #   --yawcast PATH    the binary (default: build the ci profile and use it)
 #   --work DIR        records, models and diagnoses (default target/bench-worlds)
@@ -16,6 +17,10 @@
 #   --jobs J          cases run at once (default 2)
 #   --log-wind        every record (reference and trials) logs the anemometer's apparent
 #                     wind (`simulate --log-wind`); without it, none does
+#   --augment         also run `augment --effect auto --more` on each case (the same
+#                     records, the last third of each held out) and count the hidden
+#                     effects in the model it writes (a current also where its heading/
+#                     track part estimates it)
 #
 # Per world: the reference is 3 records of the world's identification input (seeds 900–902,
 # gyro noise 0.02 °/s, heading noise 0.1°) and the model identified on them; each case is 3
@@ -35,6 +40,7 @@ strengths="1,0.5"
 effects="none,bias,gyro-bias,dead-time,rate-limit,saturation,asymmetry,nonlinear-damping,wind,current,dead-band"
 jobs=2
 logwind=""
+augment=0
 while [ $# -gt 0 ]; do
     case "$1" in
         --yawcast) yawcast="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
@@ -45,7 +51,8 @@ while [ $# -gt 0 ]; do
         --effects) effects="$2"; shift 2 ;;
         --jobs) jobs="$2"; shift 2 ;;
         --log-wind) logwind="--log-wind"; shift ;;
-        -h|--help) sed -n '2,26p' "$0"; exit 0 ;;
+        --augment) augment=1; shift ;;
+        -h|--help) sed -n '2,30p' "$0"; exit 0 ;;
         *) echo "unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
@@ -54,10 +61,13 @@ if [ -z "$yawcast" ]; then
     yawcast="${CARGO_TARGET_DIR:-$repo/target}/ci/yawcast"
 fi
 mkdir -p "$work"
-export YAWCAST="$yawcast" WORK="$work" LOGWIND="$logwind"
+export YAWCAST="$yawcast" WORK="$work" LOGWIND="$logwind" AUGMENT="$augment"
 
 # one case: world effect strength seed → a line
-# "world<TAB>strength<TAB>effect<TAB>seed<TAB>verdict<TAB>then"
+# "world<TAB>strength<TAB>effect<TAB>seed<TAB>verdict<TAB>then<TAB>augmented"
+# (augmented: the effects of the model `augment --effect auto --more` writes, joined by +,
+# with "track-current" when its heading/track part now estimates a current; "none" for
+# none, "-" without --augment, "error" when it failed)
 case_run() {
     local world="$1" effect="$2" strength="$3" seed="$4"
     local dir="$WORK/$world/$effect-$strength-$seed"
@@ -88,7 +98,19 @@ if "+" in sys.argv[2]:
 else:
     print(d["verdict"] + "\t" + then)' "$dir/diagnosis.json" "$effect")
     fi
-    printf '%s\t%s\t%s\t%s\t%s\n' "$world" "$strength" "$effect" "$seed" "$verdict"
+    local augmented="-"
+    if [ "$AUGMENT" = 1 ]; then
+        augmented="error"
+        if "$YAWCAST" augment --model "$WORK/$world/ref.postcard" --effect auto --more \
+            "${refs[@]}" "${data[@]}" --seed "$seed" --out "$dir/augmented" \
+            --json "$dir/augment.json" >"$dir/augment.log" 2>&1; then
+            augmented=$(python3 -c 'import json,sys
+a = json.load(open(sys.argv[1]))
+e = a["effects"] + (["track-current"] if (a.get("track_error_m") or {}).get("kept") else [])
+print("+".join(e) if e else "none")' "$dir/augment.json")
+        fi
+    fi
+    printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$world" "$strength" "$effect" "$seed" "$verdict" "$augmented"
 }
 export -f case_run
 
@@ -125,21 +147,33 @@ allrows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
 rows = [r for r in allrows if "+" not in r[2]]
 pairs = [r for r in allrows if "+" in r[2]]
 secs, cores = sys.argv[2], sys.argv[3]
+def accounted(augmented):
+    """The effects the model augment writes accounts for: a current in the yaw-rate model
+    or in its heading/track part."""
+    return {"current" if x == "track-current" else x for x in augmented.split("+")}
 worlds = sorted({r[0] for r in allrows}, key=["lng", "kvlcc2", "mariner"].index)
 print(f"# Cross-world diagnosis ({len(allrows)} cases, {secs} s on {cores} cores)\n")
 if pairs:
     print("## Two effects: both named by the ranked verdict (verdict, then)\n")
-    print("| world | strength | pair | cases both named | first two named |")
-    print("|---|---|---|---|---|")
+    aug = any(r[6] != "-" for r in pairs)
+    print("| world | strength | pair | cases both named | first two named |"
+          + (" both in the model augment --more writes | its effects |" if aug else ""))
+    print("|---|---|---|---|---|" + ("---|---|" if aug else ""))
     for r0 in sorted({(r[0], r[1], r[2]) for r in pairs}, key=lambda k: (worlds.index(k[0]), -float(k[1]), k[2])):
         cs = [r for r in pairs if (r[0], r[1], r[2]) == r0]
         both = sum(set(r[2].split("+")) <= set(r[4].split("+")) for r in cs)
-        print(f"| {r0[0]} | {r0[1]} | {r0[2]} | {both}/{len(cs)} | {', '.join(r[4] for r in cs)} |")
+        line = f"| {r0[0]} | {r0[1]} | {r0[2]} | {both}/{len(cs)} | {', '.join(r[4] for r in cs)} |"
+        if aug:
+            kept = sum(set(r[2].split("+")) <= accounted(r[6]) for r in cs)
+            line += f" {kept}/{len(cs)} | {', '.join(r[6] for r in cs)} |"
+        print(line)
     print()
 if not rows:
     sys.exit(0)
-print("| world | strength | effect cases right | false alarms (effect-free) | effects right in ≥ 2 of 3 seeds | a second effect named |")
-print("|---|---|---|---|---|---|")
+aug1 = any(r[6] != "-" for r in rows)
+print("| world | strength | effect cases right | false alarms (effect-free) | effects right in ≥ 2 of 3 seeds | a second effect named |"
+      + (" effect in the model augment --more writes |" if aug1 else ""))
+print("|---|---|---|---|---|---|" + ("---|" if aug1 else ""))
 for w in worlds:
     for st in sorted({r[1] for r in rows if r[0] == w}, key=float, reverse=True):
         eff = [r for r in rows if r[0] == w and r[1] == st and r[2] != "none"]
@@ -151,7 +185,10 @@ for w in worlds:
             by[r[2]].append(r[4] == r[2])
         good = sum(sum(v) * 3 >= 2 * len(v) for v in by.values())
         seconds = sum(r[5] != "-" for r in eff)
-        print(f"| {w} | {st} | {right}/{len(eff)} | {alarms}/{len(nulls)} | {good}/{len(by)} | {seconds}/{len(eff)} |")
+        extra = ""
+        if aug1:
+            extra = f" {sum(r[2] in accounted(r[6]) for r in eff)}/{len(eff)} |"
+        print(f"| {w} | {st} | {right}/{len(eff)} | {alarms}/{len(nulls)} | {good}/{len(by)} | {seconds}/{len(eff)} |" + extra)
 print("\n## Verdicts per case (hidden → named)\n")
 for w in worlds:
     for st in sorted({r[1] for r in rows if r[0] == w}, key=float, reverse=True):

@@ -117,9 +117,15 @@ pub struct AugmentSummary {
     pub sim_effect: Option<SimEffect>,
     /// The search of `--more`, or null without it.
     pub more: Option<MoreSummary>,
+    /// `--effect auto`: the effect's parameter as augment estimated it beside diagnose's
+    /// estimate, with whether they agree within the uncertainty each states and, where they
+    /// do not, why; null without `--effect auto` or for an effect without such a parameter
+    /// (wind, current).
+    pub estimate_check: Option<augment::EstimateCheck>,
     /// The effects of the model written, in the order they act.
     pub effects: Vec<String>,
-    /// `--effect current` on a model with a heading/track part and held-out records with
+    /// `--effect current` (or `--effect auto --more` with a current as the ranked verdict's
+    /// second effect) on a model with a heading/track part and held-out records with
     /// navigation channels: the track error before and after the track's current estimate.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub track_error_m: Option<TrackBeforeAfter>,
@@ -204,7 +210,12 @@ fn track_current(
             .join(", ")
     };
     println!(
-        "track error on {scored} held-out record(s): before {}; with the current estimated {}{}",
+        "track error on {scored} {}record(s): before {}; with the current estimated {}{}",
+        if args.validate.is_empty() {
+            ""
+        } else {
+            "held-out "
+        },
         line(&before),
         line(&after),
         if kept { "" } else { " (not kept)" }
@@ -232,6 +243,9 @@ pub struct MoreSummary {
     pub after: FitSummary,
     /// Every round: each effect tried with its held-out 10-step fit and gain, and the one added.
     pub rounds: Vec<RoundSummary>,
+    /// `--effect auto`: the ranked verdict's second effect, which takes precedence in the
+    /// first round when the held-out records pay for it; null otherwise.
+    pub ranked_first: Option<String>,
     /// Physical words with numbers.
     pub explanation: String,
 }
@@ -246,8 +260,9 @@ pub struct RoundSummary {
 }
 
 impl MoreSummary {
-    fn of(f: &augment::ForwardReport) -> Self {
+    fn of(f: &augment::ForwardReport, ranked_first: Option<EffectKind>) -> Self {
         MoreSummary {
+            ranked_first: ranked_first.map(|k| k.name().to_string()),
             added: f.added.iter().map(|k| k.name().to_string()).collect(),
             before: FitSummary {
                 fit: f.before.clone(),
@@ -364,11 +379,24 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
     let val = read_checked(&args.read, &args.validate, &given)?;
     let reference = read_checked(&args.read, &args.reference, &given)?;
     let seed = args.seed.resolve_for(&[&reference, &est, &val]);
-    let (kind, auto, model) = match wanted {
-        Wanted::Named(k) => (Some(k), false, given.clone()),
-        Wanted::Nothing => (None, false, given.clone()),
+    let (kind, auto, model, then, diagnosed) = match wanted {
+        Wanted::Named(k) => (Some(k), false, given.clone(), None, None),
+        Wanted::Nothing => (None, false, given.clone(), None, None),
         Wanted::Auto => {
-            let (kind, gear) = choose_auto(&given, &reference, &est, &val, seed, args.null_reps)?;
+            let Auto {
+                kind,
+                gear,
+                then,
+                parameter,
+            } = choose_auto(&given, &reference, &est, &val, seed, args.null_reps)?;
+            if let (Some(t), false) = (then, args.more) {
+                println!(
+                    "diagnose ranks {} second: --more stacks it after {} when the held-out \
+                     records pay for it",
+                    t.name(),
+                    kind.map_or("the verdict", |k| k.name())
+                );
+            }
             let model = match gear {
                 Some(g) => {
                     let check = if val.is_empty() { &est } else { &val };
@@ -380,7 +408,7 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
                 }
                 None => given.clone(),
             };
-            (kind, true, model)
+            (kind, true, model, then, parameter)
         }
     };
     let cfg = AugmentConfig::default();
@@ -390,7 +418,14 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
     let t0 = std::time::Instant::now();
     let rep = augment::augment(&model, kind, &est, &val, &cfg).map_err(cli_err)?;
     print_report(&rep, t0.elapsed().as_secs_f64());
-    let more = search_more(args, &rep.model, &est, &val, &cfg)?;
+    let estimate_check = diagnosed.and_then(|d| {
+        let eff = rep.candidate.effect(kind)?;
+        augment::check_estimate(eff, rep.std_pct.last().copied(), d, rep.candidate.ts)
+    });
+    if let Some(c) = &estimate_check {
+        println!("{}", c.line());
+    }
+    let more = search_more(args, &rep.model, &est, &val, then, &cfg)?;
     let written = more.as_ref().map_or(&rep.model, |f| &f.model);
     let what = written_kind(&given, written);
 
@@ -398,7 +433,22 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
         .first()
         .or(est.first())
         .context("no record to check the export on")?;
-    let (track_report, track_part) = if kind == EffectKind::Current {
+    // a current moves the track, whether or not it also turns the ship: the track part
+    // estimates it when it is the effect, or (with --more) the ranked verdict's second
+    let track_wanted =
+        kind == EffectKind::Current || (args.more && then == Some(EffectKind::Current));
+    if track_wanted && kind != EffectKind::Current {
+        println!(
+            "current (diagnose's second effect): it moves the ship's track; the heading/track \
+             part estimates it{}",
+            if written.effect(EffectKind::Current).is_some() {
+                ", and the yaw-rate model carries its yaw moment"
+            } else {
+                " (the yaw rate gains nothing from it: no yaw moment to carry)"
+            }
+        );
+    }
+    let (track_report, track_part) = if track_wanted {
         let held = if val.is_empty() {
             (args.data.as_slice(), est.as_slice())
         } else {
@@ -473,7 +523,8 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
             out: ex.blob_path,
             ship: ship_written,
             sim_effect,
-            more: more.as_ref().map(MoreSummary::of),
+            more: more.as_ref().map(|f| MoreSummary::of(f, then)),
+            estimate_check,
             track_error_m: track_report,
             effects: effect_names(written),
         },
@@ -485,24 +536,36 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
     Ok(())
 }
 
-/// The `--more` search from `model` (`None` without `--more`), printed.
+/// The `--more` search from `model` (`None` without `--more`), printed; `first`, the ranked
+/// verdict's second effect, takes precedence in its first round.
 fn search_more(
     args: &AugmentArgs,
     model: &Model,
     est: &[Record],
     val: &[Record],
+    first: Option<EffectKind>,
     cfg: &AugmentConfig,
 ) -> Result<Option<augment::ForwardReport>> {
     if !args.more {
         return Ok(None);
     }
     let t0 = std::time::Instant::now();
-    let f = augment::forward(model, est, val, &EffectKind::ALL, cfg).map_err(cli_err)?;
+    let f =
+        augment::forward_ranked(model, est, val, &EffectKind::ALL, first, cfg).map_err(cli_err)?;
     println!(
-        "--more: {} round{} over the effects library ({:.1} s)",
+        "--more: {} round{} over the effects library ({:.1} s){}",
         f.rounds.len(),
         if f.rounds.len() == 1 { "" } else { "s" },
-        t0.elapsed().as_secs_f64()
+        t0.elapsed().as_secs_f64(),
+        first.map_or(String::new(), |k| format!(
+            "; diagnose ranks {} second: it goes first when the held-out records pay for it{}",
+            k.name(),
+            if f.added.first() == Some(&k) {
+                " (they do)"
+            } else {
+                " (they do not)"
+            }
+        ))
     );
     for (i, r) in f.rounds.iter().enumerate() {
         for line in round_lines(i + 1, r) {
@@ -526,7 +589,7 @@ fn write_unchanged(
     auto: bool,
     cfg: &AugmentConfig,
 ) -> Result<()> {
-    let more = search_more(args, model, est, val, cfg)?;
+    let more = search_more(args, model, est, val, None, cfg)?;
     let written = more.as_ref().map_or(model, |f| &f.model);
     let what = written_kind(given, written);
     let check = val
@@ -581,7 +644,8 @@ fn write_unchanged(
             "explanation": explanation,
             "out": ex.blob_path,
             "ship": serde_json::Value::Null,
-            "more": more.as_ref().map(MoreSummary::of),
+            "more": more.as_ref().map(|f| MoreSummary::of(f, None)),
+            "estimate_check": serde_json::Value::Null,
             "effects": effect_names(written),
         }),
     )?;
@@ -621,8 +685,20 @@ fn describe_written(w: Written) -> &'static str {
     }
 }
 
-/// `--effect auto`: the verdict of `diagnose` (`None` for `none`), printed with its reasons,
-/// and the reference model with its own steering gear when diagnose found one.
+/// What `--effect auto` takes from the diagnosis.
+struct Auto {
+    /// The verdict (`None` for `none`).
+    kind: Option<EffectKind>,
+    /// The reference model with its own steering gear, when diagnose found one.
+    gear: Option<Model>,
+    /// The ranked verdict's second effect.
+    then: Option<EffectKind>,
+    /// Diagnose's estimate of the verdict's parameter and its uncertainty.
+    parameter: Option<(f64, Option<f64>)>,
+}
+
+/// `--effect auto`: the verdict of `diagnose`, printed with its reasons, and what augment
+/// takes from it ([`Auto`]).
 fn choose_auto(
     model: &Model,
     reference: &[Record],
@@ -630,7 +706,7 @@ fn choose_auto(
     val: &[Record],
     seed: u64,
     null_reps: usize,
-) -> Result<(Option<EffectKind>, Option<Model>)> {
+) -> Result<Auto> {
     let cfg = yawcast::diagnose::DiagnoseConfig {
         seed,
         null_reps,
@@ -640,7 +716,18 @@ fn choose_auto(
     };
     let d = yawcast::diagnose::diagnose(model, reference, est, val, &cfg).map_err(bad)?;
     println!("diagnose: verdict {}: {}", d.verdict, d.explanation);
-    Ok((d.verdict_kind(), d.reference_gear))
+    let then = d.then.as_deref().and_then(EffectKind::from_name);
+    let parameter = d
+        .ranking
+        .iter()
+        .find(|r| r.effect == d.verdict)
+        .and_then(|r| r.parameter.map(|p| (p, r.parameter_uncertainty)));
+    Ok(Auto {
+        kind: d.verdict_kind(),
+        gear: d.reference_gear,
+        then,
+        parameter,
+    })
 }
 
 /// Reads (or creates from the built-in ship) the ship file and adds the effect in physical

@@ -683,6 +683,7 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
                 ev.statistic = z * z;
                 ev.score = z * z - 1.0;
                 ev.parameter = Some(b);
+                ev.parameter_se = Some(se);
                 ev.channel_material = true;
                 ev.words = format!(
                     "the gyro reads {b:+.3} ± {se:.3} °/s more than the heading turns \

@@ -199,6 +199,11 @@ pub struct Ranked {
     /// The effect's estimated structural parameter in physical units, where it has one
     /// (dead time s, gear rate °/s, clip level °, gyro bias °/s, current m/s of speed over ground).
     pub parameter: Option<f64>,
+    /// How far off `parameter` may be, in its units: the standard error where a channel
+    /// measures it (the gyro offset, from the heading), or for a value searched on a grid
+    /// (dead time, gear rate, angle limit, dead band) the larger gap to its neighbouring grid
+    /// values; null otherwise.
+    pub parameter_uncertainty: Option<f64>,
     /// The evidence in words.
     pub evidence: String,
 }
@@ -418,7 +423,19 @@ pub fn diagnose(
     let passed_over = gain_before_statistic(&mut ev, &mut gains);
     bar.inc(1);
     bar.set_message("refit with the verdict's effect");
-    let (ranking, verdict) = ranked(&ev, &gains, level);
+    let (mut ranking, verdict) = ranked(&ev, &gains, level);
+    for (r, e) in ranking.iter_mut().zip(&ev) {
+        if r.parameter_uncertainty.is_none() {
+            let g = grids
+                .iter()
+                .find(|(k, _)| *k == e.kind)
+                .map(|(_, g)| &g[..]);
+            r.parameter_uncertainty = r
+                .parameter
+                .zip(g)
+                .and_then(|(v, g)| verdict::grid_gap(v, g, model.ts));
+        }
+    }
     let verdict = verdict.map(|(i, frozen_fits)| {
         let report = if cfg.confirm {
             crate::diagnose::augment::augment(model, ev[i].kind, &est_part, &held_out, &cfg.augment)

@@ -543,6 +543,7 @@ fn evidence(kind: EffectKind, p: f64, p_yaw: f64, channel_material: bool) -> Evi
         statistic: 0.0,
         words: String::new(),
         parameter: None,
+        parameter_se: None,
         channel_material,
         reference: None,
         speed_only: false,

@@ -37,6 +37,8 @@ pub(super) struct Evidence {
     pub(super) statistic: f64,
     pub(super) words: String,
     pub(super) parameter: Option<f64>,
+    /// The parameter's standard error, where a channel measures it (the gyro offset).
+    pub(super) parameter_se: Option<f64>,
     pub(super) channel_material: bool,
     /// The version of the effect the reference shows (θ frozen), if any.
     pub(super) reference: Option<Effect>,
@@ -76,6 +78,7 @@ pub(super) fn effect_evidence(
         statistic: d,
         words: String::new(),
         parameter: None,
+        parameter_se: None,
         channel_material: false,
         reference: stat.reference,
         speed_only: false,
@@ -469,6 +472,7 @@ pub(super) fn ranked(
             significant,
             material,
             parameter: e.parameter,
+            parameter_uncertainty: e.parameter_se,
             evidence: e.words.clone(),
         });
     }
@@ -704,6 +708,26 @@ pub(super) fn split(est: &[Record]) -> (Vec<Record>, Vec<Record>) {
     (a, b)
 }
 
+/// The resolution of a structural parameter found on a grid: the larger gap (in physical
+/// units, [`Effect::evidence`]) between `value` and its neighbouring grid values; `None`
+/// when the grid has no structural parameter or fewer than two values.
+pub(super) fn grid_gap(value: f64, grid: &[Effect], ts: f64) -> Option<f64> {
+    let mut v: Vec<f64> = grid
+        .iter()
+        .filter(|e| e.structural().is_some())
+        .filter_map(|e| e.evidence(ts, 0.0, SLOW_HORIZON, "").0)
+        .collect();
+    v.sort_by(f64::total_cmp);
+    v.dedup();
+    if v.len() < 2 {
+        return None;
+    }
+    let i = (0..v.len()).min_by(|&a, &b| (v[a] - value).abs().total_cmp(&(v[b] - value).abs()))?;
+    let below = i.checked_sub(1).map_or(0.0, |j| v[i] - v[j]);
+    let above = v.get(i + 1).map_or(0.0, |w| w - v[i]);
+    Some(below.max(above))
+}
+
 /// `= 3.1e-5`, or `< 1e-16` where the number is below what the tail computation resolves.
 pub(super) fn fmt_p(p: f64) -> String {
     if p < 1e-16 {
@@ -722,4 +746,22 @@ pub(super) fn fmt_p(p: f64) -> String {
 /// ```
 pub fn effect_phrase(kind: EffectKind) -> &'static str {
     crate::effects::def(kind).phrase
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_grid_value_is_as_fine_as_the_gaps_to_its_neighbours() {
+        let dead = |n| Effect::DeadTime { samples: n };
+        let g = [dead(1), dead(2), dead(3), dead(5)];
+        // dead time in seconds at ts 0.5: 0.5, 1.0, 1.5, 2.5
+        assert_eq!(grid_gap(1.5, &g, 0.5), Some(1.0));
+        assert_eq!(grid_gap(0.5, &g, 0.5), Some(0.5));
+        assert_eq!(grid_gap(1.1, &g, 0.5), Some(0.5));
+        // gains have no grid
+        assert_eq!(grid_gap(0.2, &[Effect::GyroBias { d_y: 0.0 }], 0.5), None);
+        assert_eq!(grid_gap(1.0, &[dead(2)], 0.5), None);
+    }
 }

@@ -87,6 +87,17 @@ fn diagnose_names_a_hidden_dead_time_and_writes_stable_json() {
     assert!(v["ranking"][0]["p_value"].as_f64().unwrap() < 1e-3);
     assert!(v["ranking"][0]["statistic"].as_f64().unwrap() > 0.0);
     assert!(v["ranking"][0]["fit_gain_pp"].is_number());
+    // the dead time in seconds, on diagnose's grid of whole samples: its uncertainty is one
+    // sample, and the dead time a whole number of them
+    let (p, unc) = (
+        v["ranking"][0]["parameter"].as_f64().unwrap(),
+        v["ranking"][0]["parameter_uncertainty"].as_f64().unwrap(),
+    );
+    let samples = p / unc;
+    assert!(
+        samples >= 1.0 && (samples - samples.round()).abs() < 1e-9,
+        "{p} s ± {unc}"
+    );
     assert_eq!(
         v["ranking"].as_array().unwrap().len(),
         yawcast_shared::model::EffectKind::ALL.len()
@@ -224,6 +235,29 @@ fn augment_auto_on_a_slow_gear_reference_names_and_keeps_a_slower_slew_limit() {
         v["after"]["fit"]["10"].as_f64().unwrap(),
     );
     assert!(a10 > b10 + 2.0, "{b10} → {a10}");
+    // augment's slew rate beside diagnose's, in °/s, with diagnose's grid gap as tolerance
+    let c = &v["estimate_check"];
+    eprintln!("{c}");
+    assert_eq!(c["effect"], "rate-limit", "{c}");
+    assert_eq!(c["unit"], "°/s");
+    let hidden = yawcast::effects::HIDDEN_RATE_DEGPS;
+    for k in ["augment", "diagnose"] {
+        let r = c[k].as_f64().unwrap();
+        assert!(
+            (r - hidden).abs() < 0.3 * hidden,
+            "{k} {r} vs {hidden}: {c}"
+        );
+    }
+    let tol = c["tolerance"].as_f64().unwrap();
+    assert_eq!(c["diagnose_uncertainty"].as_f64().unwrap(), tol);
+    let gap = (c["augment"].as_f64().unwrap() - c["diagnose"].as_f64().unwrap()).abs();
+    assert_eq!(c["agree"], gap <= tol, "{c}");
+    assert_eq!(c["why"].is_null(), gap <= tol, "{c}");
+    assert!(
+        stdout(&o).contains("rate-limit: augment "),
+        "{}",
+        stdout(&o)
+    );
 }
 
 #[test]
@@ -401,9 +435,12 @@ fn augment_more_searches_the_library_and_pins_its_json() {
     assert!(stdout(&o).contains("--more: "), "{}", stdout(&o));
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    // the named effect's fields as without --more
+    // the named effect's fields as without --more; no diagnosis, so no estimate beside
+    // augment's and no ranked second effect
     assert_eq!(v["effect"], "asymmetry");
     assert_eq!(v["kept"], true);
+    assert!(v["estimate_check"].is_null(), "{v}");
+    assert!(v["more"]["ranked_first"].is_null(), "{v}");
     // the search: the hull's own damping first, from the asymmetry model's held-out fit
     let more = &v["more"];
     assert_eq!(more["added"][0], "nonlinear-damping", "{more}");

@@ -116,6 +116,46 @@ pub fn forward(
     candidates: &[EffectKind],
     cfg: &AugmentConfig,
 ) -> Result<ForwardReport, AugmentError> {
+    forward_ranked(model, est, val, candidates, None, cfg)
+}
+
+/// [`forward`], with `first` taking precedence in the first round: when the rule keeps it,
+/// it is added even if another kept effect validates better at 10 steps; the search then
+/// goes on as [`forward`] does. This stacks a ranked diagnosis (`yawcast augment --effect
+/// auto --more`: the verdict's second effect first): the diagnosis names it from what the
+/// trials show and the reference lacks, while the search's own pick rests on prediction
+/// alone, where the hull's own nonlinearity can outbid it. When the rule does not keep
+/// `first`, the round picks as [`forward`] does.
+///
+/// # Errors
+/// As [`forward`].
+///
+/// ```
+/// use yawcast::{diagnose::augment::{forward_ranked, AugmentConfig}, io::data::Record, identify::model::{Effect, Model}, identify::predict};
+/// use yawcast_shared::model::EffectKind;
+/// // a 2nd-order ship whose commands arrive two samples late
+/// let truth = Model::new(1.0, vec![-0.3, 0.9], vec![0.5, 0.4], vec![0.0, 0.0]).unwrap();
+/// let delayed = truth.clone().with_effect(Effect::DeadTime { samples: 2 });
+/// let rec = |seed: usize| {
+///     let u: Vec<f64> = (0..400).map(|i| if ((i + seed) * 37 / 11) % 2 == 0 { 1.0 } else { -1.0 }).collect();
+///     let mut r = Record::from_uy("r", 1.0, u, vec![0.0; 400]);
+///     r.y = predict::simulate(&delayed, &r, &[0.0, 0.0]).iter().enumerate()
+///         .map(|(i, v)| v + 0.01 * ((i * 7919 + seed) % 13) as f64).collect();
+///     r
+/// };
+/// let cands = [EffectKind::DeadTime, EffectKind::Bias];
+/// let rep = forward_ranked(&truth, &[rec(1), rec(2)], &[rec(3), rec(4)], &cands,
+///                          Some(EffectKind::DeadTime), &AugmentConfig::default()).unwrap();
+/// assert_eq!(rep.added.first(), Some(&EffectKind::DeadTime));
+/// ```
+pub fn forward_ranked(
+    model: &Model,
+    est: &[Record],
+    val: &[Record],
+    candidates: &[EffectKind],
+    first: Option<EffectKind>,
+    cfg: &AugmentConfig,
+) -> Result<ForwardReport, AugmentError> {
     check_records(model, est, val)?;
     let mut current = model.clone();
     let mut rounds: Vec<Round> = Vec::new();
@@ -158,9 +198,11 @@ pub fn forward(
                 note: (!r.fit_gain_pp.is_finite()).then(|| r.explanation.clone()),
             })
             .collect();
+        let ranked =
+            first.filter(|k| first_round && reports.iter().any(|r| r.effect == *k && r.kept));
         let best = reports
             .into_iter()
-            .filter(|r| r.kept)
+            .filter(|r| r.kept && ranked.map_or(true, |k| r.effect == k))
             .fold(None::<AugmentReport>, |b, r| {
                 let f10 = |a: &AugmentReport| a.after.get("10").copied().unwrap_or(f64::NAN);
                 match b {

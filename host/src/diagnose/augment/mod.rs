@@ -68,6 +68,7 @@ use crate::identify::predict::Horizon;
 use crate::io::data::Record;
 
 mod actuator;
+mod agree;
 mod auto;
 mod forward;
 mod judge;
@@ -77,8 +78,9 @@ mod simulator;
 pub(crate) mod tests;
 mod words;
 
+pub use agree::{check_estimate, EstimateCheck};
 pub use auto::{gear_base, GearBase};
-pub use forward::{forward, ForwardReport, Round, Tried};
+pub use forward::{forward, forward_ranked, ForwardReport, Round, Tried};
 pub use judge::{HeldOutGain, Reason};
 pub use simulator::to_sim_effect;
 pub use words::describe;

@@ -386,6 +386,56 @@ fn forward_selection_adds_the_hulls_own_damping_after_the_diagnosed_effect() {
 }
 
 #[test]
+fn a_ranked_second_effect_goes_first_in_the_search() {
+    // trials with a hidden asymmetry and a gyro offset, augmented with the asymmetry: the
+    // plain search's first pick rests on prediction alone (the hull's own nonlinear damping
+    // outbids the offset there); ranked, the diagnosis's second effect goes first when the
+    // held-out records pay for it, and the search then goes on
+    let ship = Ship::default_lng()
+        .with_effect(SimEffect::hidden(EffectKind::Asymmetry, 1.0))
+        .with_effect(SimEffect::hidden(EffectKind::GyroBias, 1.0));
+    let est = recs(&ship, None, &EST);
+    let val = recs(&ship, None, &VAL);
+    let cfg = AugmentConfig::default();
+    let first = augment(base(), EffectKind::GyroBias, &est, &val, &cfg).unwrap();
+    assert!(first.kept, "{}", first.explanation);
+    let f = forward_ranked(
+        &first.model,
+        &est,
+        &val,
+        &EffectKind::ALL,
+        Some(EffectKind::Asymmetry),
+        &cfg,
+    )
+    .unwrap();
+    // the precedence decided: another kept effect validated better in the first round
+    let fit = |k: EffectKind| f.rounds[0].tried.iter().find(|t| t.effect == k).unwrap();
+    assert!(fit(EffectKind::Asymmetry).kept);
+    assert!(
+        f.rounds[0]
+            .tried
+            .iter()
+            .any(|t| t.kept && t.fit_10 > fit(EffectKind::Asymmetry).fit_10 + 1.0),
+        "{:?}",
+        f.rounds[0].tried
+    );
+    assert_eq!(
+        f.added.first(),
+        Some(&EffectKind::Asymmetry),
+        "{}",
+        f.explanation
+    );
+    // and the search went on: the hull's own damping after it
+    assert!(
+        f.added[1..].contains(&EffectKind::NonlinearDamping),
+        "{}",
+        f.explanation
+    );
+    assert!(f.after["10"] > f.before["10"] + 3.0, "{}", f.explanation);
+    assert!(f.model.effect(EffectKind::Asymmetry).is_some());
+}
+
+#[test]
 fn forward_selection_adds_nothing_to_a_linear_ship() {
     // records of a linear innovations model: no library effect pays for itself
     use crate::identify::pem::testdata::{record, truth};
