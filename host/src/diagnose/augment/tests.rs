@@ -18,6 +18,15 @@ fn recs(ship: &Ship, effect: Option<SimEffect>, seeds: &[u64]) -> Vec<Record> {
     simulate_many(ship, &sc, seeds).unwrap()
 }
 
+/// Estimation and validation records of the built-in ship with two effects hidden at full
+/// strength.
+fn two_hidden(a: EffectKind, b: EffectKind) -> (Vec<Record>, Vec<Record>) {
+    let ship = Ship::default_lng()
+        .with_effect(SimEffect::hidden(a, 1.0))
+        .with_effect(SimEffect::hidden(b, 1.0));
+    (recs(&ship, None, &EST), recs(&ship, None, &VAL))
+}
+
 /// The model identified on independent effect-free simulator records (the reference).
 fn base() -> &'static Model {
     static B: OnceLock<Model> = OnceLock::new();
@@ -222,11 +231,7 @@ fn effects_stack_one_after_the_other() {
     // trials with a dead time and a gyro bias: add one, then the next (the gyro bias
     // first: without it PEM parks a pole on the unit circle to follow the offset, which
     // the f32 export then refuses)
-    let ship = Ship::default_lng()
-        .with_effect(SimEffect::hidden(EffectKind::DeadTime, 1.0))
-        .with_effect(SimEffect::hidden(EffectKind::GyroBias, 1.0));
-    let est = recs(&ship, None, &EST);
-    let val = recs(&ship, None, &VAL);
+    let (est, val) = two_hidden(EffectKind::DeadTime, EffectKind::GyroBias);
     let cfg = AugmentConfig::default();
     let first = augment(base(), EffectKind::GyroBias, &est, &val, &cfg).unwrap();
     assert!(first.kept, "{}", first.explanation);
@@ -387,15 +392,11 @@ fn forward_selection_adds_the_hulls_own_damping_after_the_diagnosed_effect() {
 
 #[test]
 fn a_ranked_second_effect_goes_first_in_the_search() {
-    // trials with a hidden asymmetry and a gyro offset, augmented with the asymmetry: the
+    // trials with a hidden asymmetry and a gyro offset, augmented with the offset: the
     // plain search's first pick rests on prediction alone (the hull's own nonlinear damping
-    // outbids the offset there); ranked, the diagnosis's second effect goes first when the
+    // outbids the asymmetry there); ranked, the diagnosis's second effect goes first when the
     // held-out records pay for it, and the search then goes on
-    let ship = Ship::default_lng()
-        .with_effect(SimEffect::hidden(EffectKind::Asymmetry, 1.0))
-        .with_effect(SimEffect::hidden(EffectKind::GyroBias, 1.0));
-    let est = recs(&ship, None, &EST);
-    let val = recs(&ship, None, &VAL);
+    let (est, val) = two_hidden(EffectKind::Asymmetry, EffectKind::GyroBias);
     let cfg = AugmentConfig::default();
     let first = augment(base(), EffectKind::GyroBias, &est, &val, &cfg).unwrap();
     assert!(first.kept, "{}", first.explanation);
