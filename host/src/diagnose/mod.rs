@@ -202,7 +202,8 @@ pub struct Ranked {
     /// How far off `parameter` may be, in its units: the standard error where a channel
     /// measures it (the gyro offset, from the heading), or for a value searched on a grid
     /// (dead time, gear rate, angle limit, dead band) the larger gap to its neighbouring grid
-    /// values; null otherwise.
+    /// values — null at the grid's largest value, beyond which the truth may lie; null
+    /// otherwise.
     pub parameter_uncertainty: Option<f64>,
     /// The evidence in words.
     pub evidence: String,

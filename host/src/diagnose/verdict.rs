@@ -710,7 +710,8 @@ pub(super) fn split(est: &[Record]) -> (Vec<Record>, Vec<Record>) {
 
 /// The resolution of a structural parameter found on a grid: the larger gap (in physical
 /// units, [`Effect::evidence`]) between `value` and its neighbouring grid values; `None`
-/// when the grid has no structural parameter or fewer than two values.
+/// when the grid has no structural parameter or fewer than two values, or when `value` is
+/// the grid's largest (the true value may lie beyond it: the uncertainty is open).
 pub(super) fn grid_gap(value: f64, grid: &[Effect], ts: f64) -> Option<f64> {
     let mut v: Vec<f64> = grid
         .iter()
@@ -723,6 +724,9 @@ pub(super) fn grid_gap(value: f64, grid: &[Effect], ts: f64) -> Option<f64> {
         return None;
     }
     let i = (0..v.len()).min_by(|&a, &b| (v[a] - value).abs().total_cmp(&(v[b] - value).abs()))?;
+    if i + 1 == v.len() {
+        return None;
+    }
     let below = i.checked_sub(1).map_or(0.0, |j| v[i] - v[j]);
     let above = v.get(i + 1).map_or(0.0, |w| w - v[i]);
     Some(below.max(above))
@@ -760,6 +764,8 @@ mod tests {
         assert_eq!(grid_gap(1.5, &g, 0.5), Some(1.0));
         assert_eq!(grid_gap(0.5, &g, 0.5), Some(0.5));
         assert_eq!(grid_gap(1.1, &g, 0.5), Some(0.5));
+        // the largest grid value: the truth may lie beyond it
+        assert_eq!(grid_gap(2.5, &g, 0.5), None);
         // gains have no grid
         assert_eq!(grid_gap(0.2, &[Effect::GyroBias { d_y: 0.0 }], 0.5), None);
         assert_eq!(grid_gap(1.0, &[dead(2)], 0.5), None);

@@ -28,7 +28,8 @@ pub struct EstimateCheck {
     /// The largest difference called agreement: for a grid value diagnose's grid gap, for a
     /// gain twice the standard error of the difference; null when neither states one.
     pub tolerance: Option<f64>,
-    /// Whether `|augment − diagnose| ≤ tolerance`; null when there is no tolerance.
+    /// Whether `|augment − diagnose| ≤ tolerance`; null when there is no tolerance, or when
+    /// a gain's tolerance is as large as diagnose's value (it could not tell it from zero).
     pub agree: Option<bool>,
     /// Why the two may differ, when they do (or cannot be judged); null when they agree.
     pub why: Option<String>,
@@ -143,6 +144,11 @@ fn why_differ(kind: EffectKind) -> &'static str {
 ///     .unwrap();
 /// assert_eq!(c.agree, Some(false));
 /// assert!(c.why.unwrap().contains("heading"));
+/// // an offset augment cannot resolve (0.0 ± 5 °/s): not judged
+/// let c = check_estimate(&Effect::GyroBias { d_y: 1e-3 }, Some(5e5), (0.05, Some(0.005)), 1.0)
+///     .unwrap();
+/// assert_eq!(c.agree, None);
+/// assert!(c.why.unwrap().starts_with("the uncertainty"));
 /// ```
 pub fn check_estimate(
     augmented: &Effect,
@@ -170,11 +176,24 @@ pub fn check_estimate(
     } else {
         None
     };
-    let agree = tolerance.map(|t| (augment - diagnose).abs() <= t * (1.0 + 1e-9));
-    let why = match agree {
-        Some(true) => None,
-        Some(false) => Some(why_differ(kind).to_string()),
-        None => Some("neither states an uncertainty: not judged".to_string()),
+    // a tolerance as large as the value itself cannot tell it from zero: not judged
+    let resolved = tolerance.filter(|t| structural || *t < diagnose.abs());
+    let agree = resolved.map(|t| (augment - diagnose).abs() <= t * (1.0 + 1e-9));
+    let why = match (agree, tolerance) {
+        (Some(true), _) => None,
+        (Some(false), _) => Some(why_differ(kind).to_string()),
+        (None, Some(t)) => Some(format!(
+            "the uncertainty (± {} {}) is as large as the value: not judged; {}",
+            sig(t / 2.0),
+            unit(kind, augmented.cubic()),
+            why_differ(kind)
+        )),
+        (None, None) if structural => Some(
+            "diagnose's value is the largest of the grid it searched, so the true value may \
+             lie beyond it: not judged"
+                .to_string(),
+        ),
+        (None, None) => Some("neither states an uncertainty: not judged".to_string()),
     };
     Some(EstimateCheck {
         effect: kind.name().to_string(),
