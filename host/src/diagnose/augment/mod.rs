@@ -12,7 +12,10 @@
 //! 2. **Candidate.** The effect is appended (stacked on the model's effects).
 //!    - *Linear-gain effects* (bias, gyro bias, asymmetry, nonlinear damping, wind, current):
 //!      PEM from the ARX, ARMAX and subspace starts, from the input model with the new gain
-//!      at zero and from the baseline with the new gain at zero.
+//!      at zero and from the baseline with the new gain at zero. A gyro offset on records
+//!      that log heading is held at what the heading measures (the gyro against the
+//!      compass's turn) and the model re-identified on the yaw rate less it: on the yaw rate
+//!      alone it looks like a steady yaw moment (see `heading.rs`).
 //!    - *Actuator effects* (dead time d, gear rate ρ, angle limit δ_max, dead band b): a
 //!      grid of the structural parameter, the effect's own search
 //!      ([`crate::effects::Def::search`]: d = 1..=[`MAX_DEAD_TIME`] samples; ρ on a log grid
@@ -71,6 +74,7 @@ mod actuator;
 mod agree;
 mod auto;
 mod forward;
+mod heading;
 mod judge;
 mod refit;
 mod simulator;
@@ -324,8 +328,17 @@ fn try_effect(
     let held_note = held_note.clone();
 
     // candidate
+    let offset = heading::measured_offset(kind, model, est_part);
     let (cand, search_note) = if kind.is_actuator() {
         actuator_candidate(kind, model, &base.model, est_part, cfg)
+    } else if let Some(hb) = offset {
+        let shifted = heading::shifted(est_part, hb.bias);
+        (
+            reidentify_final(&shifted, model, std::slice::from_ref(&base.model), cfg)
+                .ok()
+                .map(|r| heading::with_measured_offset(r, hb)),
+            heading::note(hb),
+        )
     } else {
         let t = model.clone().with_effect(Effect::zero(kind, 0.0));
         // nested: from the baseline with the new gain at zero the candidate reaches the
@@ -358,7 +371,16 @@ fn try_effect(
     let mut cand_model = cand.model.clone();
     let mut std_pct = cand.std_pct.clone();
     if j.kept && held_note.is_some() {
-        if let Ok(full) = reidentify_warm(est, &cand.model, cfg) {
+        let full = match heading::measured_offset(kind, model, est) {
+            Some(hb) => reidentify_warm(
+                &heading::shifted(est, hb.bias),
+                &heading::without_offset(&cand.model),
+                cfg,
+            )
+            .map(|r| heading::with_measured_offset(r, hb)),
+            None => reidentify_warm(est, &cand.model, cfg),
+        };
+        if let Ok(full) = full {
             if full.model.is_stable() && round_trips(&full.model) {
                 cand_model = full.model;
                 std_pct = full.std_pct;

@@ -392,13 +392,13 @@ fn forward_selection_adds_the_hulls_own_damping_after_the_diagnosed_effect() {
 
 #[test]
 fn a_ranked_second_effect_goes_first_in_the_search() {
-    // trials with a hidden asymmetry and a gyro offset, augmented with the offset: the
+    // trials with a hidden asymmetry and a dead time, augmented with the dead time: the
     // plain search's first pick rests on prediction alone (the hull's own nonlinear damping
     // outbids the asymmetry there); ranked, the diagnosis's second effect goes first when the
     // held-out records pay for it, and the search then goes on
-    let (est, val) = two_hidden(EffectKind::Asymmetry, EffectKind::GyroBias);
+    let (est, val) = two_hidden(EffectKind::Asymmetry, EffectKind::DeadTime);
     let cfg = AugmentConfig::default();
-    let first = augment(base(), EffectKind::GyroBias, &est, &val, &cfg).unwrap();
+    let first = augment(base(), EffectKind::DeadTime, &est, &val, &cfg).unwrap();
     assert!(first.kept, "{}", first.explanation);
     let f = forward_ranked(
         &first.model,

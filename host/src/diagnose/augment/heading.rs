@@ -1,0 +1,120 @@
+//! A gyro offset measured on the heading: the candidate is the model re-identified on the yaw
+//! rate less the offset the heading shows, with the offset held at that measurement.
+//!
+//! On the yaw rate alone a rate-gyro offset and a steady yaw moment give the same steady
+//! output, so a model that carries a moment (a single-screw hull's reference) leaves the
+//! offset unresolved (≈ 0 ± several °/s). The heading measures it directly — the gyro against
+//! the compass's turn, which only a sensor offset moves — so where every record logs heading
+//! the offset is taken from there. The shift is exact: with `y = x₁ + d_y` the innovations of
+//! the model with `d_y` on `y` are those of the model without it on `y − d_y`, and a fit % is
+//! the same on either — unless an effect reads the measured yaw rate itself (nonlinear
+//! damping's `y|y|`), where the offset is estimated with θ as before.
+
+use yawcast_shared::model::EffectKind;
+
+use crate::identify::model::{Effect, Model};
+use crate::identify::pem::PemReport;
+use crate::io::data::{heading_bias, HeadingBias, Record};
+
+/// The offset the heading measures on `est`, when `kind` is a gyro offset, every record logs
+/// heading, and no effect of `model` reads the measured yaw rate.
+pub(super) fn measured_offset(
+    kind: EffectKind,
+    model: &Model,
+    est: &[Record],
+) -> Option<HeadingBias> {
+    if kind != EffectKind::GyroBias || model.effect(EffectKind::NonlinearDamping).is_some() {
+        return None;
+    }
+    heading_bias(est).filter(|h| h.bias.is_finite() && h.se.is_finite())
+}
+
+/// The records with `bias` taken off the yaw rate.
+pub(super) fn shifted(est: &[Record], bias: f64) -> Vec<Record> {
+    est.iter()
+        .map(|r| {
+            let mut r = r.clone();
+            r.y.iter_mut().for_each(|y| *y -= bias);
+            r
+        })
+        .collect()
+}
+
+/// `model` without its gyro offset (the structure re-identified on shifted records).
+pub(super) fn without_offset(model: &Model) -> Model {
+    let mut m = model.clone();
+    m.effects.retain(|e| e.kind() != EffectKind::GyroBias);
+    m
+}
+
+/// The report of a re-identification on shifted records as the candidate's: the model with
+/// the offset, which counts as one more parameter (its standard error the heading's, last,
+/// as a gain would be).
+pub(super) fn with_measured_offset(mut rep: PemReport, hb: HeadingBias) -> PemReport {
+    rep.model = rep.model.with_effect(Effect::GyroBias { d_y: hb.bias });
+    rep.names.push("d_y".into());
+    rep.std.push(hb.se);
+    rep.std_pct.push(100.0 * hb.se / hb.bias.abs());
+    let p = rep.cov.len();
+    for row in &mut rep.cov {
+        row.push(0.0);
+    }
+    let mut last = vec![0.0; p + 1];
+    last[p] = hb.se * hb.se;
+    rep.cov.push(last);
+    rep.aic += 2.0;
+    rep.bic += (rep.samples.max(1) as f64).ln();
+    rep
+}
+
+/// The words of the search note.
+pub(super) fn note(hb: HeadingBias) -> String {
+    format!(
+        "the offset held at what the heading measures, {:+.4} ± {:.4} °/s (the gyro against \
+         the compass's turn; on the yaw rate alone a steady yaw moment looks the same), the \
+         model re-identified on the yaw rate less it",
+        hb.bias, hb.se
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::identify::predict;
+
+    #[test]
+    fn the_shift_is_exact() {
+        // the model with an offset on y predicts as the model without it on y − offset,
+        // shifted back
+        let m = Model::new(1.0, vec![-0.3, 0.9], vec![0.5, 0.4], vec![0.2, 0.1]).unwrap();
+        let with = m.clone().with_effect(Effect::GyroBias { d_y: 0.25 });
+        let u: Vec<f64> = (0..200)
+            .map(|i| ((i / 13) % 2) as f64 * 4.0 - 2.0)
+            .collect();
+        let y: Vec<f64> = (0..200).map(|i| (i as f64 * 0.1).sin() + 0.25).collect();
+        let rec = Record::from_uy("r", 1.0, u, y);
+        let h = predict::Horizon::Steps(10);
+        let a = predict::predict(&with, &rec, &[0.0, 0.0], h);
+        let b = predict::predict(&m, &shifted(&[rec], 0.25)[0], &[0.0, 0.0], h);
+        for (p, q) in a.iter().zip(&b) {
+            assert!((p - (q + 0.25)).abs() < 1e-12, "{p} {q}");
+        }
+        assert_eq!(without_offset(&with), m);
+    }
+
+    #[test]
+    fn only_a_gyro_offset_on_records_with_heading_and_no_damping() {
+        let m = Model::new(1.0, vec![-0.3, 0.9], vec![0.5, 0.4], vec![0.2, 0.1]).unwrap();
+        let mut r = Record::from_uy("x", 1.0, vec![0.0; 400], vec![1.2; 400]);
+        assert!(measured_offset(EffectKind::GyroBias, &m, &[r.clone()]).is_none());
+        r.psi = Some((0..400).map(|i| i as f64).collect());
+        let hb = measured_offset(EffectKind::GyroBias, &m, &[r.clone()]).unwrap();
+        assert!((hb.bias - 0.2).abs() < 1e-12);
+        assert!(measured_offset(EffectKind::Bias, &m, &[r.clone()]).is_none());
+        let damped = m.with_effect(Effect::NonlinearDamping {
+            beta: -0.1,
+            cubic: false,
+        });
+        assert!(measured_offset(EffectKind::GyroBias, &damped, &[r]).is_none());
+    }
+}
