@@ -105,10 +105,11 @@ fn unit(kind: EffectKind, cubic: bool) -> &'static str {
 fn why_differ(kind: EffectKind) -> &'static str {
     match (kind, def(kind).role) {
         (EffectKind::GyroBias, _) => {
-            "augment estimates the offset from the yaw rate alone, where a steady yaw moment or \
-             an asymmetry of the gear looks much the same; diagnose reads it off the heading \
-             (the gyro against the compass's turn), which only a sensor offset moves — \
-             diagnose's is the direct measurement"
+            "augment holds the offset at the heading's measurement only where every record \
+             logs heading and the model has no nonlinear damping; otherwise it estimates it from \
+             the yaw rate alone, where a steady yaw moment or an asymmetry of the gear looks much \
+             the same, while diagnose reads it off the heading (the gyro against the compass's \
+             turn), which only a sensor offset moves — diagnose's is the direct measurement"
         }
         (_, Role::Actuator { dynamics: true }) => {
             "augment re-identifies the hull's dynamics together with the effect, diagnose holds \
