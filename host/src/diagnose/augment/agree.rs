@@ -158,10 +158,9 @@ pub fn check_estimate(
     ts: f64,
 ) -> Option<EstimateCheck> {
     let kind = augmented.kind();
-    if kind == EffectKind::Current || kind == EffectKind::Wind {
-        return None;
-    }
+    // wind and current have no parameter here (`Effect::evidence` gives none)
     let augment = augmented.evidence(ts, 0.0, 1, "").0?;
+    let unit = unit(kind, augmented.cubic());
     let (diagnose, diag_u) = diagnosed;
     let structural = augmented.structural().is_some();
     let augment_se = (!structural && def(kind).gains.len() == 1)
@@ -172,8 +171,7 @@ pub fn check_estimate(
     let tolerance = if structural {
         diag_u
     } else if diag_u.is_some() || augment_se.is_some() {
-        let (a, b) = (diag_u.unwrap_or(0.0), augment_se.unwrap_or(0.0));
-        Some(2.0 * (a * a + b * b).sqrt())
+        Some(2.0 * diag_u.unwrap_or(0.0).hypot(augment_se.unwrap_or(0.0)))
     } else {
         None
     };
@@ -184,9 +182,8 @@ pub fn check_estimate(
         (Some(true), _) => None,
         (Some(false), _) => Some(why_differ(kind).to_string()),
         (None, Some(t)) => Some(format!(
-            "the uncertainty (± {} {}) is as large as the value: not judged; {}",
+            "the uncertainty (± {} {unit}) is as large as the value: not judged; {}",
             sig(t / 2.0),
-            unit(kind, augmented.cubic()),
             why_differ(kind)
         )),
         (None, None) if structural => Some(
@@ -198,7 +195,7 @@ pub fn check_estimate(
     };
     Some(EstimateCheck {
         effect: kind.name().to_string(),
-        unit: unit(kind, augmented.cubic()).to_string(),
+        unit: unit.to_string(),
         diagnose,
         diagnose_uncertainty: diag_u,
         augment,
