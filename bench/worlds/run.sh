@@ -4,7 +4,7 @@
 #
 #   bench/worlds/run.sh [--yawcast PATH] [--work DIR] [--worlds LIST] [--seeds N]
 #                       [--strengths LIST] [--effects LIST] [--jobs J] [--log-wind]
-#                       [--augment]
+#                       [--augment] [--won-back]
 #
 #   --yawcast PATH    the binary (default: build the ci profile and use it)
 #   --work DIR        records, models and diagnoses (default target/bench-worlds)
@@ -21,6 +21,13 @@
 #                     records, the last third of each held out) and count the hidden
 #                     effects in the model it writes (a current also where its heading/
 #                     track part estimates it)
+#   --won-back        also measure the error won back: per case one more record (seed
+#                     100·s + 50, the trials' noise) with the world's own 10-step predictor
+#                     (`simulate --oracle-horizon 10`), scored at 10 steps (`compare`) for
+#                     the best linear model (the better of the reference model and one
+#                     identified on the trials) and for the model `augment --effect auto`
+#                     writes; won back = (augmented − linear) / (oracle − linear) where the
+#                     linear model is ≥ 3 pp below the oracle (median per world and strength)
 #
 # Per world: the reference is 3 records of the world's identification input (seeds 900–902,
 # gyro noise 0.02 °/s, heading noise 0.1°) and the model identified on them; each case is 3
@@ -41,6 +48,7 @@ effects="none,bias,gyro-bias,dead-time,rate-limit,saturation,asymmetry,nonlinear
 jobs=2
 logwind=""
 augment=0
+wonback=0
 while [ $# -gt 0 ]; do
     case "$1" in
         --yawcast) yawcast="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
@@ -52,7 +60,8 @@ while [ $# -gt 0 ]; do
         --jobs) jobs="$2"; shift 2 ;;
         --log-wind) logwind="--log-wind"; shift ;;
         --augment) augment=1; shift ;;
-        -h|--help) sed -n '2,30p' "$0"; exit 0 ;;
+        --won-back) wonback=1; shift ;;
+        -h|--help) sed -n '2,38p' "$0"; exit 0 ;;
         *) echo "unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
@@ -61,13 +70,15 @@ if [ -z "$yawcast" ]; then
     yawcast="${CARGO_TARGET_DIR:-$repo/target}/ci/yawcast"
 fi
 mkdir -p "$work"
-export YAWCAST="$yawcast" WORK="$work" LOGWIND="$logwind" AUGMENT="$augment"
+export YAWCAST="$yawcast" WORK="$work" LOGWIND="$logwind" AUGMENT="$augment" WONBACK="$wonback"
 
 # one case: world effect strength seed → a line
-# "world<TAB>strength<TAB>effect<TAB>seed<TAB>verdict<TAB>then<TAB>augmented"
+# "world<TAB>strength<TAB>effect<TAB>seed<TAB>verdict<TAB>then<TAB>augmented<TAB>fits"
 # (augmented: the effects of the model `augment --effect auto --more` writes, joined by +,
 # with "track-current" when its heading/track part now estimates a current; "none" for
-# none, "-" without --augment, "error" when it failed)
+# none, "-" without --augment, "error" when it failed; fits: the 10-step fit % of the
+# world's own predictor, the best linear model and augment's model on the validation
+# record, "oracle/linear/augmented", "-" without --won-back)
 case_run() {
     local world="$1" effect="$2" strength="$3" seed="$4"
     local dir="$WORK/$world/$effect-$strength-$seed"
@@ -110,7 +121,40 @@ e = a["effects"] + (["track-current"] if (a.get("track_error_m") or {}).get("kep
 print("+".join(e) if e else "none")' "$dir/augment.json")
         fi
     fi
-    printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$world" "$strength" "$effect" "$seed" "$verdict" "$augmented"
+    local fits="-"
+    if [ "$WONBACK" = 1 ]; then
+        fits="error"
+        local fit10='import json,sys
+print(json.load(open(sys.argv[1]))["records"][0]["fit"]["10"])'
+        if "$YAWCAST" simulate --world "$world" "${eff[@]}" --records 1 \
+            --seed $((100 * seed + 50)) --gyro-noise 0.03 --heading-noise 0.2 \
+            --speed-noise 0.02 $LOGWIND --oracle-horizon 10 --out "$dir/val.csv" \
+            --json "$dir/val.json" >"$dir/won-back.log" 2>&1 \
+            && "$YAWCAST" identify "${data[@]}" --out "$dir/linear" \
+                >>"$dir/won-back.log" 2>&1 \
+            && "$YAWCAST" augment --model "$WORK/$world/ref.postcard" --effect auto \
+                "${refs[@]}" "${data[@]}" --seed "$seed" --out "$dir/won" \
+                >>"$dir/won-back.log" 2>&1; then
+            local o l r a ok=1
+            o=$(python3 -c 'import json,sys
+print(json.load(open(sys.argv[1]))["records"][0]["oracle_fit_pct"])' "$dir/val.json")
+            for m in linear ref won; do
+                local path="$dir/$m.postcard"
+                [ "$m" = ref ] && path="$WORK/$world/ref.postcard"
+                "$YAWCAST" compare --model "$path" --data "$dir/val.csv" --horizons 10 \
+                    --json "$dir/val-$m.json" >>"$dir/won-back.log" 2>&1 || ok=0
+            done
+            if [ "$ok" = 1 ]; then
+                l=$(python3 -c "$fit10" "$dir/val-linear.json")
+                r=$(python3 -c "$fit10" "$dir/val-ref.json")
+                a=$(python3 -c "$fit10" "$dir/val-won.json")
+                fits=$(python3 -c 'import sys
+o, l, r, a = map(float, sys.argv[1:])
+print(f"{o:.2f}/{max(l, r):.2f}/{a:.2f}")' "$o" "$l" "$r" "$a")
+            fi
+        fi
+    fi
+    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$world" "$strength" "$effect" "$seed" "$verdict" "$augmented" "$fits"
 }
 export -f case_run
 
@@ -189,6 +233,27 @@ for w in worlds:
         if aug1:
             extra = f" {sum(r[2] in accounted(r[6]) for r in eff)}/{len(eff)} |"
         print(f"| {w} | {st} | {right}/{len(eff)} | {alarms}/{len(nulls)} | {good}/{len(by)} | {seconds}/{len(eff)} |" + extra)
+won = [r for r in rows if len(r) > 7 and r[7] not in ("-", "error") and r[2] != "none"]
+if won:
+    import statistics
+    print("\n## Error won back at 10 steps (validation record; oracle = the world's own predictor)\n")
+    print("| world | strength | cases | linear ≥ 3 pp below the oracle | median loss (pp) | median won back | cases ≥ 60 % |")
+    print("|---|---|---|---|---|---|---|")
+    for w in worlds:
+        for st in sorted({r[1] for r in won if r[0] == w}, key=float, reverse=True):
+            cs = [r for r in won if r[0] == w and r[1] == st]
+            lost = []
+            for r in cs:
+                o, l, a = map(float, r[7].split("/"))
+                if o - l >= 3.0:
+                    lost.append((o - l, 100.0 * (a - l) / (o - l)))
+            med = f"{statistics.median(x[1] for x in lost):.0f} %" if lost else "–"
+            loss = f"{statistics.median(x[0] for x in lost):.1f}" if lost else "–"
+            print(f"| {w} | {st} | {len(cs)} | {len(lost)} | {loss} | {med} | {sum(x[1] >= 60 for x in lost)}/{len(lost)} |")
+    print("\nPer case (oracle / best linear / augment --effect auto, fit % at 10 steps):\n")
+    for w in worlds:
+        for st in sorted({r[1] for r in won if r[0] == w}, key=float, reverse=True):
+            print(f"- {w}, strength {st}: " + "; ".join(f"{r[2]} s{r[3]} {r[7]}" for r in won if r[0] == w and r[1] == st))
 print("\n## Verdicts per case (hidden → named)\n")
 for w in worlds:
     for st in sorted({r[1] for r in rows if r[0] == w}, key=float, reverse=True):

@@ -143,3 +143,75 @@ fn ship_files_and_scales_belong_to_their_worlds() {
     assert!(!std::path::Path::new(out).exists());
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn the_worlds_own_predictor_is_scored_beside_the_same_record() {
+    let d = scratch("oracle");
+    let plain = simulate(&d, "p.csv", &["--world", "mariner"]);
+    let js = d.join("o.json");
+    let with = simulate(
+        &d,
+        "o.csv",
+        &[
+            "--world",
+            "mariner",
+            "--oracle-horizon",
+            "10",
+            "--json",
+            js.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(plain, with, "the record does not change");
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&js).unwrap()).unwrap();
+    assert_eq!(s["oracle_horizon"], 10);
+    let fit = s["records"][0]["oracle_fit_pct"].as_f64().unwrap();
+    assert!(fit > 50.0 && fit < 100.0, "{fit}");
+    // without the flag neither field is written
+    let js2 = d.join("p.json");
+    simulate(
+        &d,
+        "p.csv",
+        &["--world", "mariner", "--json", js2.to_str().unwrap()],
+    );
+    let s2: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&js2).unwrap()).unwrap();
+    assert!(s2.get("oracle_horizon").is_none(), "{s2}");
+    assert!(s2["records"][0].get("oracle_fit_pct").is_none(), "{s2}");
+    // the built-in ship without gyro noise: its own predictor is exact
+    let js3 = d.join("l.json");
+    simulate(
+        &d,
+        "l.csv",
+        &[
+            "--gyro-noise",
+            "0",
+            "--oracle-horizon",
+            "5",
+            "--json",
+            js3.to_str().unwrap(),
+        ],
+    );
+    let s3: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&js3).unwrap()).unwrap();
+    assert_eq!(s3["records"][0]["oracle_fit_pct"], 100.0);
+    // a horizon as long as the record is named
+    let out = d.join("x.csv");
+    let o = run(&[
+        "simulate",
+        "--duration",
+        "120",
+        "--oracle-horizon",
+        "120",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("--oracle-horizon 120"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -72,6 +72,12 @@ pub struct SimulateArgs {
     /// The measurement CSV to write.
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
+    /// Also score the world's own K-step predictor on each record: the true simulator from
+    /// the true state K samples back, driven by the logged commands (its random
+    /// disturbances decaying towards their means). Its fit % is the best a model of the
+    /// records can hope for (`oracle_fit_pct` in the JSON).
+    #[arg(long, value_name = "K")]
+    pub oracle_horizon: Option<usize>,
     /// Also write the ship used (with its effects) as TOML, to copy and edit.
     #[arg(long, value_name = "SHIP.toml")]
     pub save_ship: Option<PathBuf>,
@@ -88,6 +94,9 @@ struct Written {
     seed: u64,
     samples: usize,
     ts: f64,
+    /// Fit % of the world's own `oracle_horizon`-step predictions to the logged yaw rate.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    oracle_fit_pct: Option<f64>,
 }
 
 /// The JSON summary of `yawcast simulate`.
@@ -98,6 +107,8 @@ struct Summary {
     world: &'static str,
     ship: String,
     effects: Vec<SimEffect>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    oracle_horizon: Option<usize>,
     records: Vec<Written>,
 }
 
@@ -212,6 +223,14 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     if args.records == 0 {
         return Err(bad("--records: expected at least 1"));
     }
+    if let Some(k) = args.oracle_horizon {
+        if k == 0 || k >= n_samples {
+            return Err(bad(format!(
+                "--oracle-horizon {k}: expected 1 to {} steps (shorter than the record)",
+                n_samples.saturating_sub(1)
+            )));
+        }
+    }
     if args.out.is_none() && args.save_ship.is_none() {
         return Err(bad(
             "nothing to write: give --out FILE.csv (and/or --save-ship)",
@@ -242,39 +261,49 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     if args.out.is_some() {
         let seeds: Vec<u64> = (0..args.records as u64).map(|i| seed + i).collect();
         // the built-in ship family also logs course over ground and position
-        let recs: Vec<(Record, Option<sim::SimNav>)> = if kind == WorldKind::Lng {
-            seeds
-                .par_iter()
-                .map(|&s| {
-                    sim::simulate_with_nav(&ship, &scenario, s).map(|(mut r, n)| {
-                        r.name = format!("{}-{s}", scenario.name);
-                        (r, Some(n))
-                    })
-                })
-                .collect::<Result<Vec<_>, _>>()
-        } else {
-            world
-                .simulate_many(&scenario, &seeds)
-                .map(|v| v.into_iter().map(|r| (r, None)).collect())
-        }
-        .map_err(bad)?;
-        for (((rec, nav), s), path) in recs.iter().zip(&seeds).zip(&records) {
+        let horizon = args.oracle_horizon.unwrap_or(1);
+        let recs: Vec<(Record, Option<sim::SimNav>, sim::Oracle)> = seeds
+            .par_iter()
+            .map(|&s| {
+                let (mut r, n, o) = if kind == WorldKind::Lng {
+                    sim::simulate_with_oracle(&ship, &scenario, s, horizon)
+                        .map(|(r, n, o)| (r, Some(n), o))?
+                } else {
+                    world
+                        .simulate_with_oracle(&scenario, s, horizon)
+                        .map(|(r, o)| (r, None, o))?
+                };
+                r.name = format!("{}-{s}", scenario.name);
+                Ok((r, n, o))
+            })
+            .collect::<Result<Vec<_>, sim::SimError>>()
+            .map_err(bad)?;
+        for (((rec, nav, oracle), s), path) in recs.iter().zip(&seeds).zip(&records) {
             let text = match nav {
                 Some(n) => csv_text_with_nav(rec, &n.cog_deg, &n.north_m, &n.east_m),
                 None => yawcast::io::data::csv_text(rec),
             };
             outputs.add(path, text.into_bytes());
+            let oracle_fit_pct = args.oracle_horizon.map(|_| oracle.fit(rec));
             done.push(format!(
-                "{}: {} samples at Ts = {} s, seed {s}",
+                "{}: {} samples at Ts = {} s, seed {s}{}",
                 path.display(),
                 rec.len(),
-                rec.ts
+                rec.ts,
+                match oracle_fit_pct {
+                    Some(f) => format!(
+                        "; the world's own {}-step predictor fits its yaw rate at {f:.2} %",
+                        oracle.horizon
+                    ),
+                    None => String::new(),
+                }
             ));
             written.push(Written {
                 path: path.display().to_string(),
                 seed: *s,
                 samples: rec.len(),
                 ts: rec.ts,
+                oracle_fit_pct,
             });
         }
     }
@@ -302,6 +331,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
                 None => world.name(),
             },
             effects,
+            oracle_horizon: args.oracle_horizon,
             records: written,
         },
     )?;

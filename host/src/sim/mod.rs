@@ -46,6 +46,7 @@ use crate::io::data::Record;
 mod dynamics;
 mod inputs;
 mod manoeuvres;
+mod oracle;
 mod ship;
 mod worlds;
 
@@ -56,6 +57,7 @@ pub use crate::effects::{
 };
 pub use inputs::InputSpec;
 pub use manoeuvres::{turning_circle, zigzag, TurningResult, ZigzagResult};
+pub use oracle::{simulate_with_oracle, Oracle};
 pub use ship::{
     Actuator, HullCoefficients, MainParticulars, Pods, Ship, Windage, DEFAULT_SHIP_TOML,
 };
@@ -387,6 +389,16 @@ pub fn simulate_with_nav(
     scenario: &Scenario,
     seed: u64,
 ) -> Result<(Record, SimNav), SimError> {
+    simulate_full(ship, scenario, seed).map(|(rec, nav, _)| (rec, nav))
+}
+
+/// [`simulate_with_nav`], also returning the noise-free gyro reading of each sample (the
+/// true yaw rate plus the gyro offset, deg/s).
+fn simulate_full(
+    ship: &Ship,
+    scenario: &Scenario,
+    seed: u64,
+) -> Result<(Record, SimNav, Vec<f64>), SimError> {
     ship.validate()?;
     scenario.validate()?;
     let effects = merged_effects(ship, &scenario.effects);
@@ -462,6 +474,7 @@ pub fn simulate_with_nav(
     let mut nr = inputs::rng(seed, inputs::STREAM_NOISE);
     let ns = scenario.noise;
     let mut nav = SimNav::default();
+    let mut truth = Vec::with_capacity(n);
     for (s, _) in &states {
         nav.cog_deg
             .push((s[5] + s[1].atan2(s[0])).to_degrees().rem_euclid(360.0));
@@ -475,6 +488,7 @@ pub fn simulate_with_nav(
         } else {
             0.0
         };
+        truth.push(s[2].to_degrees() + gyro_bias);
         rec.y.push(s[2].to_degrees() + gyro_bias + g);
         let hn = if ns.heading_std_deg > 0.0 {
             ns.heading_std_deg * inputs::gauss(&mut nr)
@@ -491,7 +505,7 @@ pub fn simulate_with_nav(
         push(&mut rec.wind_speed, app.speed);
         push(&mut rec.wind_angle, app.angle.to_degrees());
     }
-    Ok((rec, nav))
+    Ok((rec, nav, truth))
 }
 
 fn push(v: &mut Option<Vec<f64>>, x: f64) {

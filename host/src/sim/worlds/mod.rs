@@ -54,13 +54,14 @@ use yawcast_shared::model::EffectKind;
 use super::dynamics::{self, Model};
 use super::inputs::{self, InputSpec, ZigZagLogic};
 use super::manoeuvres::{TurningTracker, ZigzagTracker};
-use super::{NoiseSpec, Scenario, Ship, SimEffect, SimError, TurningResult, ZigzagResult};
+use super::{NoiseSpec, Oracle, Scenario, Ship, SimEffect, SimError, TurningResult, ZigzagResult};
 use crate::effects::{HullScale, SimKnobs};
 use crate::io::data::Record;
 
 pub(crate) mod env;
 mod kvlcc2;
 mod mariner;
+mod oracle;
 
 use env::{gauss_markov, quantise, Sensors, Windage};
 
@@ -304,7 +305,36 @@ impl World {
     pub fn simulate(&self, scenario: &Scenario, seed: u64) -> Result<Record, SimError> {
         match self.hull() {
             None => super::simulate(&Ship::default_lng(), scenario, seed),
-            Some(h) => simulate_hull(h, scenario, seed),
+            Some(h) => simulate_hull(h, scenario, seed, 0).map(|(rec, _)| rec),
+        }
+    }
+
+    /// [`World::simulate`] with the world's own `horizon`-step predictions of the logged yaw
+    /// rate ([`Oracle`]): the true simulator from the true state `horizon` samples back,
+    /// driven by the logged commands, the background moment, gusts and gyro drift decaying
+    /// from their values there towards their means. The record is the same.
+    ///
+    /// # Errors
+    /// As [`World::simulate`].
+    ///
+    /// ```
+    /// use yawcast::sim::{Scenario, World, WorldKind};
+    /// let w = World::new(WorldKind::Mariner, None).unwrap();
+    /// let sc = Scenario { n_samples: 600, ..Scenario::default() };
+    /// let (rec, o10) = w.simulate_with_oracle(&sc, 1, 10).unwrap();
+    /// let (_, o1) = w.simulate_with_oracle(&sc, 1, 1).unwrap();
+    /// assert!(o1.fit(&rec) > o10.fit(&rec) && o10.fit(&rec) > 80.0);
+    /// ```
+    pub fn simulate_with_oracle(
+        &self,
+        scenario: &Scenario,
+        seed: u64,
+        horizon: usize,
+    ) -> Result<(Record, Oracle), SimError> {
+        match self.hull() {
+            None => super::simulate_with_oracle(&Ship::default_lng(), scenario, seed, horizon)
+                .map(|(rec, _, o)| (rec, o)),
+            Some(h) => simulate_hull(h, scenario, seed, horizon),
         }
     }
 
@@ -515,19 +545,66 @@ struct HullRun<'a> {
     weather: &'a [Weather],
 }
 
-/// Integrates over `spec.n` samples: at each sample `observe` sees the state and the
-/// weather (and may stop the run), then `command` gives the command (deg) held until the
-/// next sample.
+/// One sample's integration on a hull: the command history (the current sample's last)
+/// through the gear's dead time, `nsub` RK4 steps in the sample's weather.
+struct Integrator<'a> {
+    hull: &'a dyn Hull,
+    phys: &'a Physics,
+    ts: f64,
+    nsub: usize,
+    dt: f64,
+}
+
+impl<'a> Integrator<'a> {
+    fn new(hull: &'a dyn Hull, phys: &'a Physics, ts: f64, dt_max: f64) -> Integrator<'a> {
+        let nsub = (ts / dt_max).ceil().max(1.0) as usize;
+        Integrator {
+            hull,
+            phys,
+            ts,
+            nsub,
+            dt: ts / nsub as f64,
+        }
+    }
+
+    /// Advances `s` and `act` from sample `k` to `k + 1`; `hist` holds the commands of
+    /// samples `0..=k`.
+    fn sample(
+        &self,
+        k: usize,
+        s: &mut [f64; 6],
+        act: &mut dynamics::Actuator,
+        hist: &[f64],
+        w: Weather,
+    ) {
+        let t = k as f64 * self.ts;
+        for j in 0..self.nsub {
+            let tj = t + j as f64 * self.dt;
+            let tk = (tj - act.dead_time) / self.ts + 1e-9;
+            let c = if tk < 0.0 {
+                0.0
+            } else {
+                hist[(tk.floor() as usize).min(hist.len() - 1)]
+            };
+            act.step(c.to_radians(), self.dt);
+            self.phys.rk4(self.hull, s, act.delta, self.dt, w);
+        }
+    }
+}
+
+/// Integrates over `spec.n` samples: at each sample `observe` sees the state, the weather
+/// and the steering gear (and may stop the run), then `command` gives the command (deg)
+/// held until the next sample.
 fn run_hull(
     mut spec: HullRun<'_>,
     mut command: impl FnMut(usize, &[f64; 6]) -> f64,
-    mut observe: impl FnMut(usize, &[f64; 6], Weather) -> bool,
+    mut observe: impl FnMut(usize, &[f64; 6], Weather, &dynamics::Actuator) -> bool,
 ) -> Result<(), SimError> {
     let (hull, phys) = (spec.hull, spec.phys);
     let u0 = hull.u0();
     let mut s = [u0, 0.0, 0.0, 0.0, 0.0, spec.psi0_deg.to_radians()];
-    let nsub = (spec.ts / spec.dt_max).ceil().max(1.0) as usize;
-    let dt = spec.ts / nsub as f64;
+    let step = Integrator::new(hull, phys, spec.ts, spec.dt_max);
+    let dt = step.dt;
     let nwarm = (spec.warmup_s / dt).ceil() as usize;
     let act = &mut spec.act;
     for _ in 0..nwarm {
@@ -547,21 +624,11 @@ fn run_hull(
             return Err(SimError::Diverged { t_s: t });
         }
         let w = spec.weather.get(k).copied().unwrap_or(CALM);
-        if !observe(k, &s, w) || k + 1 == spec.n {
+        if !observe(k, &s, w, act) || k + 1 == spec.n {
             break;
         }
         hist.push(command(k, &s));
-        for j in 0..nsub {
-            let tj = t + j as f64 * dt;
-            let tk = (tj - act.dead_time) / spec.ts + 1e-9;
-            let c = if tk < 0.0 {
-                0.0
-            } else {
-                hist[(tk.floor() as usize).min(hist.len() - 1)]
-            };
-            act.step(c.to_radians(), dt);
-            phys.rk4(hull, &mut s, act.delta, dt, w);
-        }
+        step.sample(k, &mut s, act, &hist, w);
     }
     Ok(())
 }
@@ -581,7 +648,8 @@ fn simulate_hull(
     mut hull: Box<dyn Hull>,
     scenario: &Scenario,
     seed: u64,
-) -> Result<Record, SimError> {
+    horizon: usize,
+) -> Result<(Record, Oracle), SimError> {
     use rand::Rng;
     scenario.validate()?;
     let (phys, act, asym) = Physics::new(hull.as_ref(), &scenario.effects);
@@ -652,6 +720,7 @@ fn simulate_hull(
     };
     let mut cmds = Vec::with_capacity(n);
     let mut states: Vec<([f64; 6], Weather)> = Vec::with_capacity(n);
+    let mut gears: Vec<dynamics::Actuator> = Vec::with_capacity(n);
     run_hull(
         HullRun {
             hull,
@@ -669,8 +738,9 @@ fn simulate_hull(
             cmds.push(c);
             c
         },
-        |_, s, w| {
+        |_, s, w, act| {
             states.push((*s, w));
+            gears.push(act.clone());
             true
         },
     )?;
@@ -727,7 +797,24 @@ fn simulate_hull(
             push(&mut rec.wind_angle, va.atan2(ua).to_degrees());
         }
     }
-    Ok(rec)
+    let oracle = Oracle {
+        horizon,
+        yaw_rate_degps: oracle::predict(
+            &oracle::Replay {
+                step: Integrator::new(hull, &phys, ts, scenario.dt_max),
+                states: &states,
+                gears: &gears,
+                cmds: &cmds,
+                tau_background_s: tau_bg,
+                tau_gust_s: GUST_TAU_S * ft,
+                drift: &drift,
+                tau_drift_s: sensors.gyro_drift_tau_s,
+                gyro_bias_degps: phys.gyro_bias,
+            },
+            horizon,
+        ),
+    };
+    Ok((rec, oracle))
 }
 
 fn push(v: &mut Option<Vec<f64>>, x: f64) {
@@ -766,7 +853,7 @@ fn turning_hull(hull: &dyn Hull, delta_deg: f64) -> Result<TurningResult, SimErr
     run_hull(
         calm_run(hull, &p, act),
         |_, _| delta_deg,
-        |_, s, _| {
+        |_, s, _, _| {
             track.observe(
                 sg * s[5].to_degrees(),
                 s[3],
@@ -790,7 +877,7 @@ fn zigzag_hull(hull: &dyn Hull, delta_deg: f64, psi_deg: f64) -> Result<ZigzagRe
     run_hull(
         spec,
         |_, s| logic.command(s[5].to_degrees()),
-        |k, s, _| track.observe(k, k as f64 * ts, s[5].to_degrees()),
+        |k, s, _, _| track.observe(k, k as f64 * ts, s[5].to_degrees()),
     )?;
     track.result("")
 }

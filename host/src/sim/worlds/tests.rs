@@ -332,3 +332,100 @@ fn wind_moment_follows_the_blendermann_curve() {
     println!("apparent wind {m:.2} m/s ± {sd:.2}");
     assert!(sd / m > 0.03 && sd / m < 0.2, "{m} {sd}");
 }
+
+#[test]
+fn one_step_replays_are_the_run_itself_and_longer_ones_lose_the_disturbance() {
+    let hull = mariner::Mariner::new();
+    let n = 400;
+    let (phys, gear, _) = Physics::new(&hull, &[SimEffect::DeadTime { delay_s: 3.0 }]);
+    // a yaw moment worth ±2° of rudder, slowly varying
+    let m = rudder_moment(&hull, 2.0);
+    let weather: Vec<Weather> = (0..n)
+        .map(|k| Weather {
+            moment: m * (k as f64 * 0.05).sin(),
+            gust: 1.0,
+        })
+        .collect();
+    let cmds: Vec<f64> = (0..n)
+        .map(|k| if (k / 60) % 2 == 0 { 15.0 } else { -10.0 })
+        .collect();
+    let mut states = Vec::new();
+    let mut gears = Vec::new();
+    run_hull(
+        HullRun {
+            hull: &hull,
+            phys: &phys,
+            act: gear,
+            ts: 1.0,
+            n,
+            dt_max: 0.25,
+            warmup_s: 20.0,
+            psi0_deg: 0.0,
+            weather: &weather,
+        },
+        |k, _| cmds[k],
+        |_, s, w, g| {
+            states.push((*s, w));
+            gears.push(g.clone());
+            true
+        },
+    )
+    .unwrap();
+    let replay = oracle::Replay {
+        step: Integrator::new(&hull, &phys, 1.0, 0.25),
+        states: &states,
+        gears: &gears,
+        cmds: &cmds,
+        tau_background_s: 100.0,
+        tau_gust_s: 20.0,
+        drift: &vec![0.0; n],
+        tau_drift_s: 600.0,
+        gyro_bias_degps: 0.0,
+    };
+    let truth: Vec<f64> = states.iter().map(|(s, _)| s[2]).collect();
+    // one step from the true state in the sample's own weather is the run, bit for bit
+    let one = oracle::rates(&replay, 1);
+    assert!(one
+        .iter()
+        .zip(&truth)
+        .all(|(a, b)| a.to_bits() == b.to_bits()));
+    // ten steps ahead the moment is only expected to decay: close, not exact
+    let ten = oracle::rates(&replay, 10);
+    let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt();
+    let err: Vec<f64> = ten.iter().zip(&truth).map(|(a, b)| a - b).collect();
+    let (e, r) = (rms(&err), rms(&truth));
+    assert!(e > 1e-6 * r && e < 0.1 * r, "{e} vs {r}");
+    // the gyro reading adds the offset and the decayed drift
+    let drift: Vec<f64> = (0..n).map(|k| 0.01 * (k as f64 * 0.01).cos()).collect();
+    let read = oracle::predict(
+        &oracle::Replay {
+            drift: &drift,
+            gyro_bias_degps: 0.2,
+            ..replay
+        },
+        10,
+    );
+    let want = ten[100].to_degrees() + 0.2 + drift[90] * (-10.0f64 / 600.0).exp();
+    assert_eq!(read[100], want);
+}
+
+#[test]
+fn the_worlds_own_predictor_beats_a_linear_model_of_the_hull() {
+    use crate::identify::{pem, predict};
+    let w = World::new(WorldKind::Mariner, None).unwrap();
+    let sc = Scenario {
+        n_samples: 900,
+        input: w.default_input(),
+        ..Scenario::default()
+    };
+    let fit_on = w.simulate(&sc, 5).unwrap();
+    let (val, o10) = w.simulate_with_oracle(&sc, 6, 10).unwrap();
+    assert_eq!(val, w.simulate(&sc, 6).unwrap());
+    let m = pem::identify(&[fit_on], None, &pem::PemConfig::default())
+        .unwrap()
+        .model;
+    let linear = predict::fit_at(&m, &val, predict::Horizon::Steps(10));
+    let oracle = o10.fit(&val);
+    assert!(oracle > linear + 1.0, "{oracle} vs {linear}");
+    assert!(oracle < 100.0);
+}
