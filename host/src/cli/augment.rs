@@ -287,8 +287,26 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
     };
     let cfg = AugmentConfig::default();
     let Some(kind) = kind else {
-        return write_unchanged(args, outputs, &given, &model, &est, &val, auto, &cfg);
+        return write_unchanged(args, outputs, &given, &model, &est, &val, auto, &cfg, None);
     };
+    if auto && model.effect(kind).is_some() {
+        // diagnose tested the model's own effect for a change: re-estimate it, do not add it
+        let rep = augment::reestimate(&model, kind, &est, &val, &cfg).map_err(cli_err)?;
+        println!("{}", rep.explanation);
+        let again = Again { kind, rep, then };
+        let model = again.rep.model.clone();
+        return write_unchanged(
+            args,
+            outputs,
+            &given,
+            &model,
+            &est,
+            &val,
+            auto,
+            &cfg,
+            Some(again),
+        );
+    }
     let t0 = std::time::Instant::now();
     let rep = augment::augment(&model, kind, &est, &val, &cfg).map_err(cli_err)?;
     print_report(&rep, t0.elapsed().as_secs_f64());
@@ -450,8 +468,16 @@ fn search_more(
     Ok(Some(f))
 }
 
-/// No named effect (`--effect auto` with the verdict `none`, or `--effect none`): the input
-/// model, or with `--more` the result of the search from it, is written.
+/// `--effect auto` whose verdict the model carries already: its value re-estimated.
+struct Again {
+    kind: EffectKind,
+    rep: augment::Reestimated,
+    then: Option<EffectKind>,
+}
+
+/// No effect added (`--effect auto` with the verdict `none` or one the model carries already
+/// — `again`, re-estimated —, or `--effect none`): `model`, or with `--more` the result of
+/// the search from it, is written.
 #[allow(clippy::too_many_arguments)]
 fn write_unchanged(
     args: &AugmentArgs,
@@ -462,8 +488,10 @@ fn write_unchanged(
     val: &[Record],
     auto: bool,
     cfg: &AugmentConfig,
+    again: Option<Again>,
 ) -> Result<()> {
-    let more = search_more(args, model, est, val, None, cfg)?;
+    let first = again.as_ref().and_then(|a| a.then);
+    let more = search_more(args, model, est, val, first, cfg)?;
     let written = more.as_ref().map_or(model, |f| &f.model);
     let what = written_kind(given, written);
     let check = val
@@ -494,6 +522,7 @@ fn write_unchanged(
     }
     let searched = more.as_ref().is_some_and(|f| !f.added.is_empty());
     let explanation = match (auto, what) {
+        _ if again.is_some() => again.as_ref().map_or("", |a| a.rep.explanation.as_str()),
         (true, Written::Augmented) if !searched => {
             "diagnose found no missing effect; the model written is the reference model with \
              the steering-gear dynamics the reference records show of their own"
@@ -502,23 +531,31 @@ fn write_unchanged(
         (true, _) => "diagnose found no missing effect",
         (false, _) => "no effect named",
     };
+    let fits = |f: &BTreeMap<String, f64>| FitSummary { fit: f.clone() };
+    let gain = again.as_ref().map_or(0.0, |a| {
+        let g = |f: &BTreeMap<String, f64>| f.get("10").copied();
+        match (g(&a.rep.after), g(&a.rep.before)) {
+            (Some(x), Some(y)) if a.rep.written != Written::Input => x - y,
+            _ => 0.0,
+        }
+    });
     outputs.json(
         &args.json,
         &serde_json::json!({
             "command": "augment",
-            "effect": "none",
+            "effect": again.as_ref().map_or("none", |a| a.kind.name()),
             "auto": auto,
-            "kept": false,
+            "kept": again.as_ref().is_some_and(|a| a.rep.written != Written::Input),
             "written": what,
-            "before": serde_json::Value::Null,
-            "after": serde_json::Value::Null,
-            "fit_gain_pp": 0.0,
+            "before": again.as_ref().map(|a| fits(&a.rep.before)),
+            "after": again.as_ref().map(|a| fits(&a.rep.after)),
+            "fit_gain_pp": gain,
             "delta_aic": serde_json::Value::Null,
             "delta_bic": serde_json::Value::Null,
             "explanation": explanation,
             "out": ex.blob_path,
             "ship": serde_json::Value::Null,
-            "more": more.as_ref().map(|f| MoreSummary::of(f, None)),
+            "more": more.as_ref().map(|f| MoreSummary::of(f, first)),
             "estimate_check": serde_json::Value::Null,
             "effects": effect_names(written),
         }),

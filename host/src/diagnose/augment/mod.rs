@@ -71,6 +71,7 @@ use crate::identify::predict::Horizon;
 use crate::io::data::Record;
 
 mod actuator;
+mod again;
 mod agree;
 mod auto;
 mod forward;
@@ -82,6 +83,7 @@ mod simulator;
 pub(crate) mod tests;
 mod words;
 
+pub use again::{reestimate, Reestimated};
 pub use agree::{check_estimate, EstimateCheck};
 pub use auto::{gear_base, GearBase};
 pub use forward::{forward, forward_ranked, ForwardReport, Round, Tried};
@@ -136,6 +138,9 @@ pub enum AugmentError {
         .0.name()
     )]
     AlreadyPresent(EffectKind),
+    /// The model does not carry this effect (nothing to re-estimate).
+    #[error("the model does not carry the effect `{}`: nothing to re-estimate", .0.name())]
+    Absent(EffectKind),
 }
 
 fn ser_kind<S: Serializer>(k: &EffectKind, s: S) -> Result<S::Ok, S::Error> {
