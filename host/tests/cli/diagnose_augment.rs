@@ -261,6 +261,113 @@ fn augment_auto_on_a_slow_gear_reference_names_and_keeps_a_slower_slew_limit() {
 }
 
 #[test]
+fn augment_auto_re_estimates_an_effect_the_model_carries_when_the_trials_change_it() {
+    // the model carries a steady yaw moment (≈ 0 on these references); the trials show the
+    // library's canonical one: diagnose tests the model's own offset for a change and names
+    // it, and augment re-estimates it instead of refusing a second `bias` (this exited 1)
+    use yawcast::identify::model::Effect;
+    use yawcast::identify::pem;
+    use yawcast::sim::{simulate, Scenario, Ship, SimEffect};
+    use yawcast_shared::model::EffectKind;
+    let d = scratch("reestimate");
+    let ship = Ship::default_lng();
+    let write = |name: &str, effect: Option<SimEffect>, seeds: &[u64]| -> Vec<PathBuf> {
+        let sc = Scenario {
+            effects: effect.into_iter().collect(),
+            ..Scenario::default()
+        };
+        seeds
+            .iter()
+            .map(|&seed| {
+                let rec = simulate(&ship, &sc, seed).unwrap();
+                let p = d.join(format!("{name}-{seed}.csv"));
+                yawcast::io::data::write_csv(&p, &rec).unwrap();
+                p
+            })
+            .collect()
+    };
+    let read = |ps: &[PathBuf]| -> Vec<yawcast::io::data::Record> {
+        ps.iter()
+            .map(|p| yawcast::io::data::read_csv(p).unwrap())
+            .collect()
+    };
+    let reference = write("ref", None, &[601, 602]);
+    let plain = pem::identify(&read(&reference), None, &Default::default())
+        .unwrap()
+        .model;
+    let template = plain.with_effect(Effect::Bias { beta: 0.0 });
+    let base = pem::identify(&read(&reference), Some(&template), &Default::default())
+        .unwrap()
+        .model;
+    let Some(&Effect::Bias { beta: b0 }) = base.effect(EffectKind::Bias) else {
+        panic!("{base:?}")
+    };
+    let model = d.join("base.json");
+    std::fs::write(&model, serde_json::to_string(&base).unwrap()).unwrap();
+    let moment = SimEffect::hidden(EffectKind::Bias, 1.0);
+    let est = write("trial", Some(moment), &[21, 22]);
+    // what the trials alone say of the moment, with the same structure
+    let Some(&Effect::Bias { beta: b_trials }) =
+        pem::identify(&read(&est), Some(&base), &Default::default())
+            .unwrap()
+            .model
+            .effect(EffectKind::Bias)
+    else {
+        panic!()
+    };
+    assert!((b_trials - b0).abs() > 0.5, "{b0} vs {b_trials}");
+    let s = |p: &Path| p.display().to_string();
+    let (out, json) = (d.join("aug.postcard"), d.join("aug-summary.json"));
+    let o = run(&[
+        "augment",
+        "--model",
+        &s(&model),
+        "--effect",
+        "auto",
+        "--reference",
+        &s(&reference[0]),
+        "--reference",
+        &s(&reference[1]),
+        "--data",
+        &s(&est[0]),
+        "--data",
+        &s(&est[1]),
+        "--out",
+        &s(&out),
+        "--json",
+        &s(&json),
+        "--seed",
+        "1",
+    ]);
+    assert_eq!(code(&o), 0, "{}\n{}", stdout(&o), stderr(&o));
+    assert!(
+        stdout(&o).contains("already and the trials show it changed"),
+        "{}",
+        stdout(&o)
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["effect"], "bias", "{}", stdout(&o));
+    assert_eq!(v["kept"], true, "{}", v["explanation"]);
+    assert_eq!(v["written"], "augmented");
+    assert_eq!(v["effects"], serde_json::json!(["bias"]));
+    let (b10, a10) = (
+        v["before"]["fit"]["10"].as_f64().unwrap(),
+        v["after"]["fit"]["10"].as_f64().unwrap(),
+    );
+    assert!(a10 > b10, "{b10} → {a10}");
+    assert!((v["fit_gain_pp"].as_f64().unwrap() - (a10 - b10)).abs() < 1e-9);
+    // the model written carries the trials' moment, not the reference's
+    let twin: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("aug.json")).unwrap()).unwrap();
+    let b = twin["model"]["effects"][0]["beta"].as_f64().unwrap();
+    assert!(
+        (b - b_trials).abs() < 0.2 * (b_trials - b0).abs(),
+        "written {b}, trials alone {b_trials}, given {b0}"
+    );
+}
+
+#[test]
 fn augment_adds_a_dead_time_exports_it_and_writes_the_ship() {
     use yawcast::sim::SimEffect;
     use yawcast_shared::model::EffectKind;
