@@ -390,9 +390,11 @@ fn frozen_statistic_finds_a_known_dead_time() {
         ts: 1.0,
         u_max: 20.0,
         du_max: 40.0,
+        shortest: 1500,
         ..Default::default()
     };
     let cands = grid(EffectKind::DeadTime, &span);
+    assert_eq!(cands.len(), 32, "the firmware's delay line");
     let q = set.family(&truth, &cands, 1, false);
     let (s0, n) = set.sse0(&truth, 1);
     let none = Version {

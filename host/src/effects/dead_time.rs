@@ -20,11 +20,14 @@ pub(super) const DEF: Def = Def {
     search,
 };
 
-/// Diagnose: 1 sample up to 8 s (at most 20 samples).
+/// Diagnose: what augment searches and the firmware can carry ([`search`]), every whole
+/// sample up to the delay line or a tenth of the shortest record, whatever the hull.
 fn candidates(g: &GridSpan) -> Vec<Effect> {
-    let dmax = ((8.0 / g.ts).ceil() as usize).clamp(1, 20);
-    (1..=dmax)
-        .map(|d| Effect::DeadTime { samples: d })
+    search(g)
+        .into_iter()
+        .map(|d| Effect::DeadTime {
+            samples: d as usize,
+        })
         .collect()
 }
 
@@ -92,14 +95,14 @@ mod tests {
             shortest: 100,
             ..GridSpan::default()
         };
-        assert_eq!(candidates(&g).len(), 8);
+        assert_eq!(candidates(&g).len(), 10);
         assert_eq!(search(&g), (1..=10).map(f64::from).collect::<Vec<_>>());
         let g = GridSpan {
             ts: 0.1,
             shortest: 10_000,
             ..g
         };
-        assert_eq!(candidates(&g).len(), 20);
+        assert_eq!(candidates(&g).len(), MAX_DEAD_TIME as usize);
         assert_eq!(search(&g).len(), MAX_DEAD_TIME as usize);
         assert_eq!(describe(1, 0.5), "a command dead time of 1 sample (0.5 s)");
     }
