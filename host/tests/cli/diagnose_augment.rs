@@ -267,31 +267,15 @@ fn augment_auto_re_estimates_an_effect_the_model_carries_when_the_trials_change_
     // it, and augment re-estimates it instead of refusing a second `bias` (this exited 1)
     use yawcast::identify::model::Effect;
     use yawcast::identify::pem;
-    use yawcast::sim::{simulate, Scenario, Ship, SimEffect};
+    use yawcast::sim::SimEffect;
     use yawcast_shared::model::EffectKind;
     let d = scratch("reestimate");
-    let ship = Ship::default_lng();
-    let write = |name: &str, effect: Option<SimEffect>, seeds: &[u64]| -> Vec<PathBuf> {
-        let sc = Scenario {
-            effects: effect.into_iter().collect(),
-            ..Scenario::default()
-        };
-        seeds
-            .iter()
-            .map(|&seed| {
-                let rec = simulate(&ship, &sc, seed).unwrap();
-                let p = d.join(format!("{name}-{seed}.csv"));
-                yawcast::io::data::write_csv(&p, &rec).unwrap();
-                p
-            })
-            .collect()
-    };
     let read = |ps: &[PathBuf]| -> Vec<yawcast::io::data::Record> {
         ps.iter()
             .map(|p| yawcast::io::data::read_csv(p).unwrap())
             .collect()
     };
-    let reference = write("ref", None, &[601, 602]);
+    let reference = sim_csvs(&d, "ref", None, &[601, 602]);
     let plain = pem::identify(&read(&reference), None, &Default::default())
         .unwrap()
         .model;
@@ -305,7 +289,7 @@ fn augment_auto_re_estimates_an_effect_the_model_carries_when_the_trials_change_
     let model = d.join("base.json");
     std::fs::write(&model, serde_json::to_string(&base).unwrap()).unwrap();
     let moment = SimEffect::hidden(EffectKind::Bias, 1.0);
-    let est = write("trial", Some(moment), &[21, 22]);
+    let est = sim_csvs(&d, "trial", Some(moment), &[21, 22]);
     // what the trials alone say of the moment, with the same structure
     let Some(&Effect::Bias { beta: b_trials }) =
         pem::identify(&read(&est), Some(&base), &Default::default())
