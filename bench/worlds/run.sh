@@ -37,6 +37,9 @@
 # verdict. Prints per world and strength: right / cases, false alarms on effect-free trials,
 # and each effect's verdicts; the per-case verdicts are in DIR/cases.tsv.
 set -euo pipefail
+# bash reads a script as it runs it: the body is one block, read whole before it starts, so
+# an edit of this file during a (long) run cannot change that run
+{
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 
 yawcast=""
@@ -279,3 +282,5 @@ for w in worlds:
             line.append(f"{e}: " + " ".join("✓" if v == e else v for v in vs))
         print(f"- {w}, strength {st}: " + "; ".join(line))
 EOF
+exit
+}
