@@ -261,7 +261,8 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     if args.out.is_some() {
         let seeds: Vec<u64> = (0..args.records as u64).map(|i| seed + i).collect();
         // the built-in ship family also logs course over ground and position
-        let horizon = args.oracle_horizon.unwrap_or(1);
+        // without --oracle-horizon nothing is replayed: 0 steps ahead is the run itself
+        let horizon = args.oracle_horizon.unwrap_or(0);
         let recs: Vec<(Record, Option<sim::SimNav>, sim::Oracle)> = seeds
             .par_iter()
             .map(|&s| {

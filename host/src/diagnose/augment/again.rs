@@ -96,10 +96,7 @@ pub fn reestimate(
         )),
     }
     if let Some(h) = &prep.held_note {
-        let mut c = h.chars();
-        if let Some(f) = c.next() {
-            explanation.push_str(&format!(" {}{}.", f.to_uppercase(), c.as_str()));
-        }
+        explanation.push_str(&format!(" Note: {h}."));
     }
     Ok(Reestimated {
         model: written_model,
