@@ -55,7 +55,9 @@
 //!   prediction is not named ahead of a significant effect that does; and, the one ranking
 //!   rule above the statistics, no effect whose held-out gain is below 0.5 pp is named ahead
 //!   of a significant one whose gain is 1 pp or more (a sensor offset with nothing to win
-//!   back becomes a note behind it). The verdict's effect
+//!   back becomes a note behind it); nor is an effect that predicts the held-out records
+//!   worse than another significant one both at 10 steps and in simulation (by 0.5 pp at
+//!   one of them). The verdict's effect
 //!   is then refitted with the model ([`crate::diagnose::augment::augment`]) for the before/after fits.
 //! - **Current or wind.** A uniform current carries the ship: speed over ground varies with
 //!   heading by the current's speed (first harmonic), but the hull sees the same water
@@ -104,8 +106,8 @@ use evidence::{grid, reference_versions, trial_stats, Set};
 use null::bootstrap;
 use reference::{foreign, reference_actuator};
 use verdict::{
-    caveats, cfg_m, effect_evidence, frozen_gain, gain_before_statistic, rank, ranked, split,
-    verdict_words, yaw_before_speed, Evidence,
+    caveats, cfg_m, effect_evidence, frozen_gain, gain_before_statistic, outpredicted, rank,
+    ranked, split, verdict_words, yaw_before_speed, Evidence,
 };
 
 pub use crate::io::data::{heading_bias, HeadingBias};
@@ -192,6 +194,11 @@ pub struct Ranked {
     /// hull effects, `sim` for slow ones) of the model with the effect added (θ frozen, the
     /// effect's gains fitted on the estimation part); 0 for effects that are not significant.
     pub fit_gain_pp: f64,
+    /// Held-out fit gain (pp) at 10 steps, as `fit_gain_pp` measures it; 0 for effects that
+    /// are not significant. With `fit_gain_sim_pp`, what the ranking rule compares.
+    pub fit_gain_10_pp: f64,
+    /// Held-out fit gain (pp) in simulation; 0 for effects that are not significant.
+    pub fit_gain_sim_pp: f64,
     /// p-value below α/m (m: the number of library effects, Bonferroni).
     pub significant: bool,
     /// Held-out improvement on refit, or measurable channel evidence.
@@ -422,9 +429,10 @@ pub fn diagnose(
         .collect();
     yaw_before_speed(&mut ev, &mut gains);
     let passed_over = gain_before_statistic(&mut ev, &mut gains);
+    let outpredicted = outpredicted(&mut ev, &mut gains, &base_before);
     bar.inc(1);
     bar.set_message("refit with the verdict's effect");
-    let (mut ranking, verdict) = ranked(&ev, &gains, level);
+    let (mut ranking, verdict) = ranked(&ev, &gains, level, &base_before);
     for (r, e) in ranking.iter_mut().zip(&ev) {
         if r.parameter_uncertainty.is_none() {
             let g = grids
@@ -471,6 +479,14 @@ pub fn diagnose(
     if let Some(k) = passed_over.filter(|k| k.name() != verdict_name) {
         caveats.push(Caveat::PassedOver {
             effect: k.name().into(),
+        });
+    }
+    if let Some(o) = outpredicted.filter(|o| o.by.name() == verdict_name) {
+        caveats.push(Caveat::Outpredicted {
+            effect: o.kind.name().into(),
+            gains_pp: o.gains,
+            by: o.by.name().into(),
+            by_gains_pp: o.by_gains,
         });
     }
     // the second effect of a ranked verdict, against the model with the first added

@@ -6,7 +6,9 @@ use yawcast_shared::model::EffectKind;
 use super::channels::Channels;
 use super::compare::mean_fit;
 use super::evidence::{trial_stats, Set, Version};
-use super::verdict::{effect_evidence, frozen_gain, rank, Evidence, GAIN_PP};
+use super::verdict::{
+    effect_evidence, frozen_gain, gains_at, outpredicts, rank, Evidence, GAIN_PP,
+};
 use super::DiagnoseConfig;
 use crate::effects::{def, Channel};
 use crate::identify::model::{Effect, Model};
@@ -25,7 +27,9 @@ use crate::io::data::Record;
 /// [`GAIN_PP`] or more — θ frozen leaves part of the first effect in the errors, which reads
 /// as its neighbour (a saturation's remainder as an asymmetry) without improving prediction
 /// — or that its own channel shows with no yaw-rate part (a gyro offset, a current from
-/// speed over ground alone); `None` without one.
+/// speed over ground alone); `None` without one. When that is current or wind and the other
+/// is significant too, the one that predicts the held-out records better at both horizons
+/// ([`outpredicts`]: the ranking rule's second clause) is named.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn second_effect(
     base: &Model,
@@ -74,5 +78,41 @@ pub(super) fn second_effect(
             && ((e.channel_material && (e.speed_only || def(e.kind).channel == Channel::Heading))
                 || frozen_gain(with_first, e, &est_set, held.1, &before, cfg.parallel).0 >= GAIN_PP)
     })?;
+    // current or wind: the ranking rule's second clause between the two, as in the first
+    // stage — the one that predicts the held-out records better at both horizons is named
+    let partner = match ev[pick].kind {
+        EffectKind::Current => Some(EffectKind::Wind),
+        EffectKind::Wind => Some(EffectKind::Current),
+        _ => None,
+    };
+    if let Some(j) = partner.and_then(|k| ev.iter().position(|e| e.kind == k && e.p < level)) {
+        let held_out = |e: &Evidence| {
+            let g = Some(frozen_gain(
+                with_first,
+                e,
+                &est_set,
+                held.1,
+                &before,
+                cfg.parallel,
+            ));
+            gains_at(&g, &before)
+        };
+        if let (Some(gp), Some(gj)) = (held_out(&ev[pick]), held_out(&ev[j])) {
+            if outpredicts(gj, gp) {
+                let words = format!(
+                    "; named ahead of {} beside the first effect: it predicts the held-out \
+                     records better at 10 steps ({:+.2} pp against {:+.2}) and in simulation \
+                     ({:+.2} pp against {:+.2})",
+                    ev[pick].kind.name(),
+                    gj[0],
+                    gp[0],
+                    gj[1],
+                    gp[1]
+                );
+                ev[j].words.push_str(&words);
+                return Some(ev.swap_remove(j));
+            }
+        }
+    }
     Some(ev.swap_remove(pick))
 }

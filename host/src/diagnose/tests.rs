@@ -630,6 +630,74 @@ fn an_offset_without_gain_is_a_note_behind_an_effect_that_improves_prediction() 
 }
 
 #[test]
+fn an_effect_that_predicts_worse_at_both_horizons_is_named_behind() {
+    use super::verdict::outpredicted;
+    let before: BTreeMap<String, f64> = [("10".to_string(), 80.0), ("sim".to_string(), 60.0)]
+        .into_iter()
+        .collect();
+    // held-out fits from gains (pp) at 10 steps and in simulation; `own`: the effect's own
+    // horizon's gain, as `frozen_gain` reports it
+    let held = |g10: f64, gsim: f64, own: f64| {
+        let fits: BTreeMap<String, f64> = [
+            ("10".to_string(), 80.0 + g10),
+            ("sim".to_string(), 60.0 + gsim),
+        ]
+        .into_iter()
+        .collect();
+        Some((own, fits))
+    };
+    // Mariner, asymmetry hidden (seed 3 at full strength): the steady moment has the larger
+    // statistic (its 50-step horizon), the asymmetry predicts better at both horizons
+    let mut ev = vec![
+        evidence(EffectKind::Bias, 4e-8, 4e-8, false),
+        evidence(EffectKind::Asymmetry, 5e-21, 5e-21, false),
+    ];
+    let mut gains = vec![held(0.50, 7.20, 7.20), held(1.82, 9.61, 1.82)];
+    let o = outpredicted(&mut ev, &mut gains, &before).expect("moved");
+    assert_eq!((o.kind, o.by), (EffectKind::Bias, EffectKind::Asymmetry));
+    assert!((o.gains[1] - 7.20).abs() < 1e-9 && (o.by_gains[0] - 1.82).abs() < 1e-9);
+    assert_eq!(ev[0].kind, EffectKind::Asymmetry);
+    assert_eq!(gains[0].as_ref().unwrap().0, 1.82);
+    assert!(
+        ev[1].words.contains("named behind asymmetry"),
+        "{}",
+        ev[1].words
+    );
+    assert!(
+        ev[0].words.contains("named ahead of bias"),
+        "{}",
+        ev[0].words
+    );
+    // better at one horizon only, or by less than 0.5 pp at both: the statistic decides
+    for (a, b) in [
+        ((0.50, 7.20), (1.82, 6.01)),
+        ((0.50, 7.20), (0.90, 7.60)),
+        ((0.50, 7.20), (0.50, 9.61)),
+    ] {
+        let mut ev = vec![
+            evidence(EffectKind::Bias, 4e-8, 4e-8, false),
+            evidence(EffectKind::Asymmetry, 5e-21, 5e-21, false),
+        ];
+        let mut gains = vec![held(a.0, a.1, a.1), held(b.0, b.1, b.0)];
+        assert!(
+            outpredicted(&mut ev, &mut gains, &before).is_none(),
+            "{a:?} {b:?}"
+        );
+        assert_eq!(ev[0].kind, EffectKind::Bias);
+    }
+    // an effect its own channel shows is not displaced by one no channel shows, and an
+    // effect not significant (no held-out figures) displaces nothing
+    let mut ev = vec![
+        evidence(EffectKind::GyroBias, 0.0, 0.5, true),
+        evidence(EffectKind::Bias, 1e-9, 1e-9, false),
+        evidence(EffectKind::Wind, 0.5, 0.5, false),
+    ];
+    let mut gains = vec![held(0.1, 6.3, 6.3), held(0.6, 7.4, 7.4), None];
+    assert!(outpredicted(&mut ev, &mut gains, &before).is_none());
+    assert_eq!(ev[0].kind, EffectKind::GyroBias);
+}
+
+#[test]
 fn speed_over_ground_alone_is_not_named_ahead_of_a_yaw_effect() {
     let level = 0.01 / 9.0;
     let mut cur = evidence(EffectKind::Current, 9e-4, 1.0, true);

@@ -225,6 +225,99 @@ pub(super) fn gain_before_statistic(
     Some(passed)
 }
 
+/// The horizons on which [`outpredicted`] compares held-out prediction: 10 steps (where
+/// actuator and hull effects show) and simulation (where slow moments show).
+pub(super) const COMPARED: [&str; 2] = ["10", "sim"];
+
+/// Held-out gains (pp) of a significant effect at the [`COMPARED`] horizons over `before`
+/// (the fits of the model without it); `None` for an effect not significant.
+pub(super) fn gains_at(g: &HeldOut, before: &Fits) -> Option<[f64; 2]> {
+    let fits = &g.as_ref()?.1;
+    let at = |k: &str| match (fits.get(k), before.get(k)) {
+        (Some(a), Some(b)) if (a - b).is_finite() => a - b,
+        _ => f64::NEG_INFINITY,
+    };
+    Some(COMPARED.map(at))
+}
+
+/// Does an effect with held-out gains `a` predict better than one with `b` at both
+/// [`COMPARED`] horizons, by at least [`NO_GAIN_PP`] at one of them?
+pub(super) fn outpredicts(a: [f64; 2], b: [f64; 2]) -> bool {
+    a[0] > b[0] && a[1] > b[1] && (a[0] - b[0] >= NO_GAIN_PP || a[1] - b[1] >= NO_GAIN_PP)
+}
+
+/// An effect the ranking rule passed over for one that predicts the held-out records better
+/// at both horizons ([`outpredicted`]).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Outpredicted {
+    /// The effect passed over.
+    pub(super) kind: EffectKind,
+    /// Its held-out gains (pp) at the [`COMPARED`] horizons.
+    pub(super) gains: [f64; 2],
+    /// The effect named ahead of it.
+    pub(super) by: EffectKind,
+    /// Its gains.
+    pub(super) by_gains: [f64; 2],
+}
+
+/// The ranking rule's second clause: the likelihood statistic ranks effects, but an effect
+/// that predicts the held-out records worse than another significant effect both at 10 steps
+/// and in simulation — by [`NO_GAIN_PP`] or more at one of them — is not named ahead of it.
+/// Each effect's statistic is measured on its own horizon (one step for an actuator, 50 for
+/// a slow moment), so two look-alikes (a port/starboard asymmetry and a steady moment, a
+/// wind's heading-dependent moment and a current's) can rank by the horizon that favours one
+/// while the other predicts better on both; the held-out records at both horizons are the
+/// common yardstick. An effect its own channel shows (heading, speed over ground) is not
+/// displaced by one no channel shows. Applied to the first material effect (as [`ranked`]
+/// names it) until none outpredicts it (`before`: the held-out fits without any effect);
+/// returns the first effect passed over.
+pub(super) fn outpredicted(
+    ev: &mut Vec<Evidence>,
+    gains: &mut Vec<HeldOut>,
+    before: &Fits,
+) -> Option<Outpredicted> {
+    let mut first = None;
+    // strict at both horizons: no cycle, at most one move per effect
+    for _ in 0..ev.len() {
+        let i = first_material(ev, gains)?;
+        let gi = gains_at(&gains[i], before)?;
+        let j = (i + 1..ev.len())
+            .filter(|&j| ev[j].channel_material >= ev[i].channel_material)
+            // itself material (as `first_material` judges), so that it is what is named
+            .filter(|&j| ev[j].channel_material || gain_of(&gains[j]).is_some_and(|v| v > 0.0))
+            .filter_map(|j| Some((j, gains_at(&gains[j], before)?)))
+            .filter(|&(_, gj)| outpredicts(gj, gi))
+            .max_by(|a, b| (a.1[0] + a.1[1]).total_cmp(&(b.1[0] + b.1[1])));
+        let Some((j, gj)) = j else {
+            return first;
+        };
+        let words = format!(
+            "; named behind {}: it predicts the held-out records worse at 10 steps \
+             ({:+.2} pp against {:+.2}) and in simulation ({:+.2} pp against {:+.2}) — an \
+             effect that predicts worse at both horizons is not named ahead",
+            ev[j].kind.name(),
+            gi[0],
+            gj[0],
+            gi[1],
+            gj[1],
+        );
+        let promoted = format!(
+            "; named ahead of {}: it predicts the held-out records better at 10 steps and in \
+             simulation",
+            ev[i].kind.name()
+        );
+        ev[j].words.push_str(&promoted);
+        first.get_or_insert(Outpredicted {
+            kind: ev[i].kind,
+            gains: gi,
+            by: ev[j].kind,
+            by_gains: gj,
+        });
+        move_ahead(ev, gains, i, j, &words);
+    }
+    first
+}
+
 /// Current or wind, when speed over ground is logged (module docs): a uniform current carries
 /// the ship without a heading-dependent yaw moment, wind turns it. "Wind" nests "current"
 /// (the speed harmonics are free in both; wind adds the yaw-moment harmonics), so the
@@ -453,12 +546,14 @@ pub(super) fn ranked(
     ev: &[Evidence],
     gains: &[Option<(f64, Fits)>],
     level: f64,
+    before: &Fits,
 ) -> (Vec<Ranked>, Option<(usize, Fits)>) {
     let mut ranking = Vec::new();
     let mut verdict: Option<(usize, BTreeMap<String, f64>)> = None;
     for (i, (e, g)) in ev.iter().zip(gains).enumerate() {
         let significant = e.p < level;
         let fit_gain = g.as_ref().map_or(0.0, |g| g.0);
+        let [fit_gain_10_pp, fit_gain_sim_pp] = gains_at(g, before).unwrap_or([0.0; 2]);
         let material = significant && (e.channel_material || fit_gain > 0.0);
         if material && verdict.is_none() {
             verdict = g.as_ref().map(|g| (i, g.1.clone()));
@@ -469,6 +564,8 @@ pub(super) fn ranked(
             p_value: e.p,
             above_noise: e.score,
             fit_gain_pp: fit_gain,
+            fit_gain_10_pp,
+            fit_gain_sim_pp,
             significant,
             material,
             parameter: e.parameter,
@@ -600,6 +697,19 @@ pub enum Caveat {
         /// Its name.
         effect: String,
     },
+    /// An effect with the larger likelihood statistic was named behind one that predicts the
+    /// held-out records better both at 10 steps and in simulation (the ranking rule's second
+    /// clause).
+    Outpredicted {
+        /// Its name.
+        effect: String,
+        /// Its held-out gains (pp) at 10 steps and in simulation.
+        gains_pp: [f64; 2],
+        /// The effect named ahead of it.
+        by: String,
+        /// That effect's held-out gains (pp) at 10 steps and in simulation.
+        by_gains_pp: [f64; 2],
+    },
 }
 
 impl Caveat {
@@ -654,6 +764,26 @@ impl Caveat {
                      prediction; by the ranking rule no effect that does not improve prediction \
                      (< {NO_GAIN_PP} pp) is named ahead of one that does (≥ {GAIN_PP} pp).",
                     kind.map_or("an effect", effect_phrase)
+                )
+            }
+            Caveat::Outpredicted {
+                effect,
+                gains_pp,
+                by,
+                by_gains_pp,
+            } => {
+                let kind = EffectKind::from_name(effect);
+                format!(
+                    "Note: {} ({effect}) has the larger likelihood statistic but predicts the \
+                     held-out records worse than {by} at 10 steps ({:+.2} pp against {:+.2}) \
+                     and in simulation ({:+.2} pp against {:+.2}); by the ranking rule an \
+                     effect that predicts worse at both horizons (by {NO_GAIN_PP} pp or more \
+                     at one) is not named ahead.",
+                    kind.map_or("an effect", effect_phrase),
+                    gains_pp[0],
+                    by_gains_pp[0],
+                    gains_pp[1],
+                    by_gains_pp[1],
                 )
             }
         }

@@ -87,6 +87,22 @@ fn diagnose_names_a_hidden_dead_time_and_writes_stable_json() {
     assert!(v["ranking"][0]["p_value"].as_f64().unwrap() < 1e-3);
     assert!(v["ranking"][0]["statistic"].as_f64().unwrap() > 0.0);
     assert!(v["ranking"][0]["fit_gain_pp"].is_number());
+    // the held-out gains the ranking rule compares: a dead time is judged at 10 steps, so
+    // its own gain is its 10-step one; an effect not significant has none
+    assert_eq!(
+        v["ranking"][0]["fit_gain_10_pp"].as_f64(),
+        v["ranking"][0]["fit_gain_pp"].as_f64()
+    );
+    assert!(v["ranking"][0]["fit_gain_sim_pp"]
+        .as_f64()
+        .unwrap()
+        .is_finite());
+    for r in v["ranking"].as_array().unwrap() {
+        if r["significant"] == false {
+            assert_eq!(r["fit_gain_10_pp"], 0.0, "{r}");
+            assert_eq!(r["fit_gain_sim_pp"], 0.0, "{r}");
+        }
+    }
     // the dead time in seconds, on diagnose's grid of whole samples: its uncertainty is one
     // sample, and the dead time a whole number of them
     let (p, unc) = (
