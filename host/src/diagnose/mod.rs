@@ -82,6 +82,7 @@ mod evidence;
 mod null;
 mod reference;
 pub mod resid;
+mod rule;
 mod second;
 #[cfg(test)]
 pub(crate) mod tests;
@@ -105,9 +106,9 @@ use channels::Channels;
 use evidence::{grid, reference_versions, trial_stats, Set};
 use null::bootstrap;
 use reference::{foreign, reference_actuator};
+use rule::{gain_before_statistic, outpredicted, yaw_before_speed};
 use verdict::{
-    caveats, cfg_m, effect_evidence, frozen_gain, gain_before_statistic, outpredicted, rank,
-    ranked, split, verdict_words, yaw_before_speed, Evidence,
+    caveats, cfg_m, effect_evidence, frozen_gain, rank, ranked, split, verdict_words, Evidence,
 };
 
 pub use crate::io::data::{heading_bias, HeadingBias};

@@ -6,9 +6,8 @@ use yawcast_shared::model::EffectKind;
 use super::channels::Channels;
 use super::compare::mean_fit;
 use super::evidence::{trial_stats, Set, Version};
-use super::verdict::{
-    effect_evidence, frozen_gain, gains_at, outpredicts, rank, Evidence, GAIN_PP,
-};
+use super::rule::{gains_at, outpredicts, GAIN_PP};
+use super::verdict::{effect_evidence, frozen_gain, rank, Evidence};
 use super::DiagnoseConfig;
 use crate::effects::{def, Channel};
 use crate::identify::model::{Effect, Model};

@@ -599,7 +599,7 @@ fn speed_lost_in_turns_is_not_a_current() {
 
 #[test]
 fn an_offset_without_gain_is_a_note_behind_an_effect_that_improves_prediction() {
-    use super::verdict::gain_before_statistic;
+    use super::rule::gain_before_statistic;
     let fits = BTreeMap::new();
     let run = |g_first: f64, g_second: f64| {
         let mut ev = vec![
@@ -631,7 +631,7 @@ fn an_offset_without_gain_is_a_note_behind_an_effect_that_improves_prediction() 
 
 #[test]
 fn an_effect_that_predicts_worse_at_both_horizons_is_named_behind() {
-    use super::verdict::outpredicted;
+    use super::rule::outpredicted;
     let before: BTreeMap<String, f64> = [("10".to_string(), 80.0), ("sim".to_string(), 60.0)]
         .into_iter()
         .collect();

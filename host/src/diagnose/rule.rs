@@ -1,0 +1,197 @@
+//! The ranking rule: held-out prediction above the likelihood statistics — an effect that
+//! does not improve prediction is never named ahead of one that does, and one that predicts
+//! worse at both horizons is not named ahead of one that predicts better.
+
+use std::collections::BTreeMap;
+
+use yawcast_shared::model::EffectKind;
+
+use super::verdict::Evidence;
+
+/// Held-out fit % keyed by horizon ("1","5","10","20","sim").
+type Fits = BTreeMap<String, f64>;
+
+/// An effect named from speed over ground alone — current or wind while the yaw channel
+/// shows no heading-dependent moment ([`Evidence::speed_only`]) — that buys no held-out
+/// yaw-rate prediction is not named ahead of a significant effect that does: it explains
+/// none of the yaw-rate departures the other one explains, and a yaw-rate predictor is what
+/// the model is. The first such effect behind it moves ahead of it (`gains[i]`: held-out
+/// gain and fits of the significant effects, in the order of `ev`).
+pub(super) fn yaw_before_speed(ev: &mut Vec<Evidence>, gains: &mut Vec<HeldOut>) {
+    let Some(i) = first_material(ev, gains) else {
+        return;
+    };
+    let gi = gain_of(&gains[i]).unwrap_or(0.0);
+    if !ev[i].speed_only || gi > 0.0 {
+        return;
+    }
+    let Some(j) = (i + 1..ev.len())
+        .find(|&j| !ev[j].speed_only && gain_of(&gains[j]).is_some_and(|v| v > 0.0))
+    else {
+        return;
+    };
+    let gj = gain_of(&gains[j]).unwrap_or(0.0);
+    let words = format!(
+        "; named behind {}: only speed over ground shows it (the yaw channel shows no \
+         heading-dependent moment) and it buys no held-out yaw-rate prediction ({gi:+.1} pp), \
+         where {} is significant in the yaw rate and buys {gj:+.1} pp",
+        ev[j].kind.name(),
+        ev[j].kind.name(),
+    );
+    move_ahead(ev, gains, i, j, &words);
+}
+
+/// Held-out gain (pp) and fits of a significant effect; `None` for the others.
+pub(super) type HeldOut = Option<(f64, Fits)>;
+
+fn gain_of(g: &HeldOut) -> Option<f64> {
+    g.as_ref().map(|g| g.0)
+}
+
+/// The first effect both significant and material (its channel shows it, or it improves
+/// held-out prediction), as [`super::verdict::ranked`] names it.
+fn first_material(ev: &[Evidence], gains: &[HeldOut]) -> Option<usize> {
+    (0..ev.len()).find(|&i| {
+        gains[i].is_some()
+            && (ev[i].channel_material || gain_of(&gains[i]).is_some_and(|v| v > 0.0))
+    })
+}
+
+/// Moves effect `j` (and its held-out figures) ahead of effect `i`, whose evidence says why.
+fn move_ahead(ev: &mut Vec<Evidence>, gains: &mut Vec<HeldOut>, i: usize, j: usize, why: &str) {
+    ev[i].words.push_str(why);
+    let e = ev.remove(j);
+    ev.insert(i, e);
+    let g = gains.remove(j);
+    gains.insert(i, g);
+}
+
+/// Held-out gain (pp) below which an effect counts as not improving prediction, for
+/// [`gain_before_statistic`].
+pub(super) const NO_GAIN_PP: f64 = 0.5;
+/// Held-out gain (pp) at and above which an effect counts as improving prediction.
+pub(super) const GAIN_PP: f64 = 1.0;
+
+/// The ranking rule the verdict states: an effect that does not improve held-out prediction
+/// (gain < [`NO_GAIN_PP`]) is never named ahead of a significant effect that does
+/// (≥ [`GAIN_PP`]), whatever their statistics — a sensor offset its own channel shows, with
+/// nothing to win back in the prediction, becomes a note behind the effect that does. The
+/// first such effect behind the first material one moves ahead of it (`gains[i]`: held-out
+/// gain and fits of the significant effects, in the order of `ev`). Returns the effect
+/// passed over, if any.
+pub(super) fn gain_before_statistic(
+    ev: &mut Vec<Evidence>,
+    gains: &mut Vec<HeldOut>,
+) -> Option<EffectKind> {
+    let i = first_material(ev, gains)?;
+    let gi = gain_of(&gains[i]).unwrap_or(0.0);
+    if gi >= NO_GAIN_PP {
+        return None;
+    }
+    let j = (i + 1..ev.len()).find(|&j| gain_of(&gains[j]).is_some_and(|v| v >= GAIN_PP))?;
+    let gj = gain_of(&gains[j]).unwrap_or(0.0);
+    let words = format!(
+        "; named behind {} (a note, not the verdict): it improves held-out prediction by \
+         {gi:+.1} pp, where {} is significant and improves it by {gj:+.1} pp — an effect \
+         that does not improve prediction (< {NO_GAIN_PP} pp) is never named ahead of one \
+         that does (≥ {GAIN_PP} pp)",
+        ev[j].kind.name(),
+        ev[j].kind.name(),
+    );
+    let passed = ev[i].kind;
+    move_ahead(ev, gains, i, j, &words);
+    Some(passed)
+}
+
+/// The horizons on which [`outpredicted`] compares held-out prediction: 10 steps (where
+/// actuator and hull effects show) and simulation (where slow moments show).
+pub(super) const COMPARED: [&str; 2] = ["10", "sim"];
+
+/// Held-out gains (pp) of a significant effect at the [`COMPARED`] horizons over `before`
+/// (the fits of the model without it); `None` for an effect not significant.
+pub(super) fn gains_at(g: &HeldOut, before: &Fits) -> Option<[f64; 2]> {
+    let fits = &g.as_ref()?.1;
+    let at = |k: &str| match (fits.get(k), before.get(k)) {
+        (Some(a), Some(b)) if (a - b).is_finite() => a - b,
+        _ => f64::NEG_INFINITY,
+    };
+    Some(COMPARED.map(at))
+}
+
+/// Does an effect with held-out gains `a` predict better than one with `b` at both
+/// [`COMPARED`] horizons, by at least [`NO_GAIN_PP`] at one of them?
+pub(super) fn outpredicts(a: [f64; 2], b: [f64; 2]) -> bool {
+    a[0] > b[0] && a[1] > b[1] && (a[0] - b[0] >= NO_GAIN_PP || a[1] - b[1] >= NO_GAIN_PP)
+}
+
+/// An effect the ranking rule passed over for one that predicts the held-out records better
+/// at both horizons ([`outpredicted`]).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Outpredicted {
+    /// The effect passed over.
+    pub(super) kind: EffectKind,
+    /// Its held-out gains (pp) at the [`COMPARED`] horizons.
+    pub(super) gains: [f64; 2],
+    /// The effect named ahead of it.
+    pub(super) by: EffectKind,
+    /// Its gains.
+    pub(super) by_gains: [f64; 2],
+}
+
+/// The ranking rule's second clause: the likelihood statistic ranks effects, but an effect
+/// that predicts the held-out records worse than another significant effect both at 10 steps
+/// and in simulation — by [`NO_GAIN_PP`] or more at one of them — is not named ahead of it.
+/// Each effect's statistic is measured on its own horizon (one step for an actuator, 50 for
+/// a slow moment), so two look-alikes (a port/starboard asymmetry and a steady moment, a
+/// wind's heading-dependent moment and a current's) can rank by the horizon that favours one
+/// while the other predicts better on both; the held-out records at both horizons are the
+/// common yardstick. An effect its own channel shows (heading, speed over ground) is not
+/// displaced by one no channel shows. Applied to the first material effect (as [`super::verdict::ranked`]
+/// names it) until none outpredicts it (`before`: the held-out fits without any effect);
+/// returns the first effect passed over.
+pub(super) fn outpredicted(
+    ev: &mut Vec<Evidence>,
+    gains: &mut Vec<HeldOut>,
+    before: &Fits,
+) -> Option<Outpredicted> {
+    let mut first = None;
+    // strict at both horizons: no cycle, at most one move per effect
+    for _ in 0..ev.len() {
+        let i = first_material(ev, gains)?;
+        let gi = gains_at(&gains[i], before)?;
+        let j = (i + 1..ev.len())
+            .filter(|&j| ev[j].channel_material >= ev[i].channel_material)
+            // itself material (as `first_material` judges), so that it is what is named
+            .filter(|&j| ev[j].channel_material || gain_of(&gains[j]).is_some_and(|v| v > 0.0))
+            .filter_map(|j| Some((j, gains_at(&gains[j], before)?)))
+            .filter(|&(_, gj)| outpredicts(gj, gi))
+            .max_by(|a, b| (a.1[0] + a.1[1]).total_cmp(&(b.1[0] + b.1[1])));
+        let Some((j, gj)) = j else {
+            return first;
+        };
+        let words = format!(
+            "; named behind {}: it predicts the held-out records worse at 10 steps \
+             ({:+.2} pp against {:+.2}) and in simulation ({:+.2} pp against {:+.2}) — an \
+             effect that predicts worse at both horizons is not named ahead",
+            ev[j].kind.name(),
+            gi[0],
+            gj[0],
+            gi[1],
+            gj[1],
+        );
+        let promoted = format!(
+            "; named ahead of {}: it predicts the held-out records better at 10 steps and in \
+             simulation",
+            ev[i].kind.name()
+        );
+        ev[j].words.push_str(&promoted);
+        first.get_or_insert(Outpredicted {
+            kind: ev[i].kind,
+            gains: gi,
+            by: ev[j].kind,
+            by_gains: gj,
+        });
+        move_ahead(ev, gains, i, j, &words);
+    }
+    first
+}
