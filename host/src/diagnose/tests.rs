@@ -807,8 +807,10 @@ fn a_second_effect_is_measured_against_the_model_with_the_first() {
     // the damping is what is left
     let refs = records(None, &[900, 901, 902]);
     let model = identify(&refs);
+    // the second stage does not use the verdict's confirming refit (only `after` does)
     let cfg = DiagnoseConfig {
         seed: 4,
+        confirm: false,
         ..DiagnoseConfig::default()
     };
     let mut sc = Scenario {
