@@ -9,7 +9,16 @@ use yawcast_shared::model::EffectKind;
 use super::verdict::Evidence;
 
 /// Held-out fit % keyed by horizon ("1","5","10","20","sim").
-type Fits = BTreeMap<String, f64>;
+pub(super) type Fits = BTreeMap<String, f64>;
+
+/// Held-out gain (pp) at horizon `key`: `fits` less `before` (the fits without the effect);
+/// −∞ where either is missing or not finite.
+pub(super) fn gain_at(fits: &Fits, before: &Fits, key: &str) -> f64 {
+    match (fits.get(key), before.get(key)) {
+        (Some(a), Some(b)) if (a - b).is_finite() => a - b,
+        _ => f64::NEG_INFINITY,
+    }
+}
 
 /// An effect named from speed over ground alone — current or wind while the yaw channel
 /// shows no heading-dependent moment ([`Evidence::speed_only`]) — that buys no held-out
@@ -48,13 +57,16 @@ fn gain_of(g: &HeldOut) -> Option<f64> {
     g.as_ref().map(|g| g.0)
 }
 
-/// The first effect both significant and material (its channel shows it, or it improves
-/// held-out prediction), as [`super::verdict::ranked`] names it.
+/// Is effect `i` both significant (it has held-out figures) and material (its channel shows
+/// it, or it improves held-out prediction), as [`super::verdict::ranked`] judges it?
+fn is_material(ev: &[Evidence], gains: &[HeldOut], i: usize) -> bool {
+    gains[i].is_some() && (ev[i].channel_material || gain_of(&gains[i]).is_some_and(|v| v > 0.0))
+}
+
+/// The first effect both significant and material ([`is_material`]), as
+/// [`super::verdict::ranked`] names it.
 fn first_material(ev: &[Evidence], gains: &[HeldOut]) -> Option<usize> {
-    (0..ev.len()).find(|&i| {
-        gains[i].is_some()
-            && (ev[i].channel_material || gain_of(&gains[i]).is_some_and(|v| v > 0.0))
-    })
+    (0..ev.len()).find(|&i| is_material(ev, gains, i))
 }
 
 /// Moves effect `j` (and its held-out figures) ahead of effect `i`, whose evidence says why.
@@ -107,15 +119,15 @@ pub(super) fn gain_before_statistic(
 /// actuator and hull effects show) and simulation (where slow moments show).
 pub(super) const COMPARED: [&str; 2] = ["10", "sim"];
 
-/// Held-out gains (pp) of a significant effect at the [`COMPARED`] horizons over `before`
-/// (the fits of the model without it); `None` for an effect not significant.
+/// Held-out gains (pp) at the [`COMPARED`] horizons of a model with held-out `fits` over
+/// `before` (the fits of the model without its effect).
+pub(super) fn compared_gains(fits: &Fits, before: &Fits) -> [f64; 2] {
+    COMPARED.map(|k| gain_at(fits, before, k))
+}
+
+/// [`compared_gains`] of a significant effect; `None` for an effect not significant.
 pub(super) fn gains_at(g: &HeldOut, before: &Fits) -> Option<[f64; 2]> {
-    let fits = &g.as_ref()?.1;
-    let at = |k: &str| match (fits.get(k), before.get(k)) {
-        (Some(a), Some(b)) if (a - b).is_finite() => a - b,
-        _ => f64::NEG_INFINITY,
-    };
-    Some(COMPARED.map(at))
+    Some(compared_gains(&g.as_ref()?.1, before))
 }
 
 /// Does an effect with held-out gains `a` predict better than one with `b` at both
@@ -146,9 +158,9 @@ pub(super) struct Outpredicted {
 /// wind's heading-dependent moment and a current's) can rank by the horizon that favours one
 /// while the other predicts better on both; the held-out records at both horizons are the
 /// common yardstick. An effect its own channel shows (heading, speed over ground) is not
-/// displaced by one no channel shows. Applied to the first material effect (as [`super::verdict::ranked`]
-/// names it) until none outpredicts it (`before`: the held-out fits without any effect);
-/// returns the first effect passed over.
+/// displaced by one no channel shows. Applied to the first material effect (as
+/// [`super::verdict::ranked`] names it) until none outpredicts it (`before`: the held-out
+/// fits without any effect); returns the first effect passed over.
 pub(super) fn outpredicted(
     ev: &mut Vec<Evidence>,
     gains: &mut Vec<HeldOut>,
@@ -161,8 +173,8 @@ pub(super) fn outpredicted(
         let gi = gains_at(&gains[i], before)?;
         let j = (i + 1..ev.len())
             .filter(|&j| ev[j].channel_material >= ev[i].channel_material)
-            // itself material (as `first_material` judges), so that it is what is named
-            .filter(|&j| ev[j].channel_material || gain_of(&gains[j]).is_some_and(|v| v > 0.0))
+            // itself material, so that it is what is named
+            .filter(|&j| is_material(ev, gains, j))
             .filter_map(|j| Some((j, gains_at(&gains[j], before)?)))
             .filter(|&(_, gj)| outpredicts(gj, gi))
             .max_by(|a, b| (a.1[0] + a.1[1]).total_cmp(&(b.1[0] + b.1[1])));

@@ -6,7 +6,7 @@ use yawcast_shared::model::EffectKind;
 use super::channels::Channels;
 use super::compare::mean_fit;
 use super::evidence::{trial_stats, Set, Version};
-use super::rule::{gains_at, outpredicts, GAIN_PP};
+use super::rule::{compared_gains, outpredicts, GAIN_PP};
 use super::verdict::{effect_evidence, frozen_gain, rank, Evidence};
 use super::DiagnoseConfig;
 use crate::effects::{def, Channel};
@@ -86,31 +86,23 @@ pub(super) fn second_effect(
     };
     if let Some(j) = partner.and_then(|k| ev.iter().position(|e| e.kind == k && e.p < level)) {
         let held_out = |e: &Evidence| {
-            let g = Some(frozen_gain(
-                with_first,
-                e,
-                &est_set,
-                held.1,
-                &before,
-                cfg.parallel,
-            ));
-            gains_at(&g, &before)
+            let (_, fits) = frozen_gain(with_first, e, &est_set, held.1, &before, cfg.parallel);
+            compared_gains(&fits, &before)
         };
-        if let (Some(gp), Some(gj)) = (held_out(&ev[pick]), held_out(&ev[j])) {
-            if outpredicts(gj, gp) {
-                let words = format!(
-                    "; named ahead of {} beside the first effect: it predicts the held-out \
-                     records better at 10 steps ({:+.2} pp against {:+.2}) and in simulation \
-                     ({:+.2} pp against {:+.2})",
-                    ev[pick].kind.name(),
-                    gj[0],
-                    gp[0],
-                    gj[1],
-                    gp[1]
-                );
-                ev[j].words.push_str(&words);
-                return Some(ev.swap_remove(j));
-            }
+        let (gp, gj) = (held_out(&ev[pick]), held_out(&ev[j]));
+        if outpredicts(gj, gp) {
+            let words = format!(
+                "; named ahead of {} beside the first effect: it predicts the held-out \
+                 records better at 10 steps ({:+.2} pp against {:+.2}) and in simulation \
+                 ({:+.2} pp against {:+.2})",
+                ev[pick].kind.name(),
+                gj[0],
+                gp[0],
+                gj[1],
+                gp[1]
+            );
+            ev[j].words.push_str(&words);
+            return Some(ev.swap_remove(j));
         }
     }
     Some(ev.swap_remove(pick))

@@ -13,7 +13,7 @@ use super::channels::{add_channels, Channels};
 use super::compare::mean_fit;
 use super::evidence::{effect_with, horizon_of, Quad, Set, WorldStat};
 use super::null::Null;
-use super::rule::{gains_at, GAIN_PP, NO_GAIN_PP};
+use super::rule::{gain_at, gains_at, Fits, GAIN_PP, NO_GAIN_PP};
 use super::{DiagnoseConfig, Ranked, SLOW_HORIZON, WINDOW, WINDOW_BLOCK};
 use crate::identify::model::{Effect, Model};
 use crate::identify::predict::Horizon;
@@ -345,15 +345,8 @@ pub(super) fn frozen_gain(
     let m = model.clone().with_effect(effect_with(&cand, &beta));
     let fits = mean_fit(&m, held_out, &Horizon::REPORT);
     let key = if e.h == 1 { "10" } else { "sim" };
-    let gain = match (fits.get(key), before.get(key)) {
-        (Some(a), Some(b)) if (a - b).is_finite() => a - b,
-        _ => f64::NEG_INFINITY,
-    };
-    (gain, fits)
+    (gain_at(&fits, before, key), fits)
 }
-
-/// Held-out fit % keyed by horizon ("1","5","10","20","sim").
-type Fits = BTreeMap<String, f64>;
 
 /// The ranking in the order of `ev` (`gains[i]`: held-out gain and fits of the significant
 /// effects), and the verdict: the first effect both significant and material, with its
