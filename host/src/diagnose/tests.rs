@@ -292,6 +292,24 @@ fn the_anemometer_shows_wind_and_not_a_current() {
     assert!((speed - speed_mps).abs() < 0.05 * speed_mps, "{speed}");
     assert!((from - from_deg).abs() < 3.0, "{from}");
     assert!(a.p < 1e-12, "{a:?}");
+    // the same records as a ship's NMEA log (HDT, ROT, RSA, VTG, MWV): the course over
+    // ground the log carries reaches the record, and the anemometer shows the same wind
+    let opts = crate::io::nmea::NmeaOptions {
+        clock: crate::io::nmea::Clock::Rate(1.0),
+        ..Default::default()
+    };
+    let as_log = |recs: &[Record]| -> Vec<Record> {
+        let log = |r: &Record| crate::io::nmea::tests::log_of(r);
+        let read = |r: &Record| crate::io::nmea::parse_nmea(&log(r), "t.nmea".as_ref(), "t", &opts);
+        recs.iter().map(|r| read(r).unwrap()).collect()
+    };
+    let b = anemometer_evidence(&as_log(&wind), &as_log(&reference)).expect("course read");
+    let (s2, f2) = b.speed_from();
+    assert!(
+        (s2 - speed).abs() < 0.02 * speed && (f2 - from).abs() < 1.0,
+        "{b:?}"
+    );
+    assert!(b.p < 1e-12, "{b:?}");
     let level = 0.01 / 10.0;
     for (what, effects) in [
         ("a current", vec![w.hidden(EffectKind::Current, 1.0)]),

@@ -8,15 +8,17 @@
 //! | `$--RSA` rudder sensor angle | angle `δ` (required) | deg; both sensors valid → their mean |
 //! | `$--HDT` true heading | heading `ψ` | deg (unwrapped) |
 //! | `$--HDG` magnetic heading | heading `ψ` when no HDT | sensor + deviation + variation (E +) |
-//! | `$--VTG` course/speed over ground | speed `u`; course (navigation) | knots (or km/h) → m/s; deg true |
+//! | `$--VTG` course/speed over ground | speed `u`; course `cog` (and navigation) | knots (or km/h) → m/s; deg true |
 //! | `$--MWV` wind speed and angle | relative wind | `R` reference only; N/M/K/S → m/s |
 //! | `$--ZDA`, `$--RMC` | the clock | UTC time and date |
 //! | `$--GGA` (else `$--RMC`) | position (navigation) | latitude, longitude in degrees (valid fixes only) |
-//! | `$--RMC` | course (navigation) when there is no `VTG` | deg true |
+//! | `$--RMC` | course `cog` (and navigation) when there is no `VTG` | deg true |
 //!
 //! The navigation channels (course over ground, position) never shape the record: they are
 //! read by [`parse_nmea_nav`] onto the record's own grid, a gap in them leaving `NaN` (a
-//! skipped correction) rather than an error.
+//! skipped correction) rather than an error. The course over ground read so also fills the
+//! record's [`Record::cog`] (what `diagnose` reads the current across the track and the true
+//! wind from, as from a CSV `cog_deg` column).
 //!
 //! HDT, VTG, MWV, ZDA and RMC are parsed by the `nmea` crate; ROT, RSA and HDG by the small
 //! parsers here ([`parse_rot`], [`parse_rsa`], [`parse_hdg`]). Other sentences are checked
@@ -300,12 +302,20 @@ pub fn parse_nmea(
             }
         }
     }
-    let items: Vec<(usize, Item)> = scan(text, path, opts)?
-        .into_iter()
+    let all = scan(text, path, opts)?;
+    let items: Vec<(usize, Item)> = all
+        .iter()
+        .copied()
         .filter(|(_, it)| !matches!(it, Item::Value(c, _) if c.is_nav()))
         .collect();
     let series = timestamp(&items, path, opts)?;
-    resample(series, path, name, opts)
+    let mut rec = resample(series, path, name, opts)?;
+    // the course over ground on the record's own grid, as `parse_nmea_nav` reads it (`NaN`
+    // where missing): the ground-velocity channels of `diagnose` read it from the record
+    if let Ok(all) = timestamp(&all, path, opts) {
+        rec.cog = nav_on_grid(&all, opts, &rec).course;
+    }
+    Ok(rec)
 }
 
 /// The navigation channels of an NMEA log on the grid of its record `rec` (as
@@ -323,6 +333,12 @@ pub fn parse_nmea_nav(
 ) -> Result<NmeaNav, NmeaError> {
     let items = scan(text, path, opts)?;
     let series = timestamp(&items, path, opts)?;
+    Ok(nav_on_grid(&series, opts, rec))
+}
+
+/// The navigation channels of `series` (a whole log's, timestamped) on the grid of its
+/// record `rec` ([`parse_nmea_nav`]).
+fn nav_on_grid(series: &Series, opts: &NmeaOptions, rec: &Record) -> NmeaNav {
     // the record's grid starts where every record channel has data (as in `resample`)
     let t_start = series
         .iter()
@@ -344,7 +360,7 @@ pub fn parse_nmea_nav(
         (Some(la), Some(lo)) => Some(la.into_iter().zip(lo).map(|(a, b)| [a, b]).collect()),
         _ => None,
     };
-    Ok(NmeaNav { course, position })
+    NmeaNav { course, position }
 }
 
 /// The navigation channels of an NMEA log on its record's grid ([`parse_nmea_nav`]).
@@ -878,4 +894,4 @@ fn interp(v: &[(f64, f64, usize)], grid: &[f64], angular: bool) -> Vec<f64> {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

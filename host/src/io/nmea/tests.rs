@@ -150,6 +150,12 @@ fn navigation_channels_on_the_record_grid() {
     let c = nn.course.as_ref().unwrap();
     assert_eq!(c.len(), 19);
     assert!(c.iter().all(|&v| v == 45.0), "{c:?}");
+    // and in the record itself, bit for bit
+    let rc = r.cog.as_ref().expect("the record carries the course");
+    assert_eq!(
+        rc.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+        c.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+    );
     // the one GGA fix comes before the first clock sentence and is dropped (and with a GGA
     // in the log, RMC positions are not used): no position, never a guess
     assert!(nn.position.is_none());
@@ -169,4 +175,62 @@ fn navigation_channels_on_the_record_grid() {
     // 3 kn along 45°: equal north and east components
     let v = nav.velocity(5).unwrap();
     assert!((v[0] - v[1]).abs() < 1e-9 && (v[0] - 1.543333 * 0.5f64.sqrt()).abs() < 1e-6);
+}
+
+/// A record written as the NMEA log a ship's logger would keep, one sentence per channel per
+/// sample, the `ROT` count the clock ([`Clock::Rate`] at the record's rate): `ROT`, `RSA`,
+/// and where the record has them `HDT`, `VTG` (course and speed over ground) and `MWV`
+/// (relative wind, m/s).
+pub(crate) fn log_of(r: &Record) -> String {
+    let line = |body: String| format!("${body}*{:02X}\n", checksum(&body));
+    let mut s = String::new();
+    for t in 0..r.len() {
+        s += &line(format!("HEROT,{:.3},A", 60.0 * r.y[t]));
+        s += &line(format!("IIRSA,{:.3},A,,V", r.u[t]));
+        if let Some(p) = &r.psi {
+            s += &line(format!("HEHDT,{:.3},T", p[t].rem_euclid(360.0)));
+        }
+        if let (Some(v), Some(c)) = (&r.speed, &r.cog) {
+            let kn = v[t] / 0.514_444;
+            s += &line(format!(
+                "GPVTG,{:.3},T,,M,{kn:.4},N,{:.4},K,A",
+                c[t].rem_euclid(360.0),
+                v[t] * 3.6
+            ));
+        }
+        if let (Some(w), Some(a)) = (&r.wind_speed, &r.wind_angle) {
+            s += &line(format!(
+                "WIMWV,{:.2},R,{:.3},M,A",
+                a[t].rem_euclid(360.0),
+                w[t]
+            ));
+        }
+    }
+    s
+}
+
+#[test]
+fn a_record_written_as_a_log_reads_back() {
+    let mut r = Record::from_uy("r", 1.0, vec![5.0, -5.0, 2.0], vec![0.5, -0.25, 0.1]);
+    r.psi = Some(vec![359.5, 0.5, 1.0]);
+    r.speed = Some(vec![3.0, 3.1, 3.2]);
+    r.cog = Some(vec![10.0, 12.0, 14.0]);
+    let opts = NmeaOptions {
+        clock: Clock::Rate(1.0),
+        ..NmeaOptions::default()
+    };
+    let back = parse(&log_of(&r), &opts).unwrap();
+    assert_eq!((back.len(), back.ts), (3, 1.0));
+    assert_eq!(back.u, r.u);
+    assert!(back.y.iter().zip(&r.y).all(|(a, b)| (a - b).abs() < 1e-4));
+    assert_eq!(back.psi.as_ref().unwrap(), &[359.5, 360.5, 361.0]);
+    let c = back.cog.as_ref().unwrap();
+    assert!(
+        c.iter()
+            .zip([10.0, 12.0, 14.0])
+            .all(|(a, b)| (a - b).abs() < 1e-9),
+        "{c:?}"
+    );
+    let v = back.speed.as_ref().unwrap();
+    assert!((v[2] - 3.2).abs() < 1e-4, "{v:?}");
 }
