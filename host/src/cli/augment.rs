@@ -568,15 +568,16 @@ fn write_unchanged(
 }
 
 /// What the written model is against the model the user gave: `Augmented` when it carries
-/// an effect that one lacks (or the same effect with another value), `Input` when it is that
-/// model, else `Refit` (the same structure, re-identified).
+/// an effect kind that one lacks, `Input` when it is that model, else `Refit` (the same
+/// structure re-identified — its own effects' values re-estimated with θ, as a refit of a
+/// reference model that carries a steady moment does, is not an effect added).
 fn written_kind(given: &Model, written: &Model) -> Written {
     if written == given {
         Written::Input
     } else if written
         .effects
         .iter()
-        .any(|e| given.effect(e.kind()) != Some(e))
+        .any(|e| given.effect(e.kind()).is_none())
     {
         Written::Augmented
     } else {
@@ -755,6 +756,28 @@ fn report_lines(rep: &AugmentReport, secs: f64) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_refit_of_a_model_with_its_own_moment_is_a_refit_not_an_augmentation() {
+        // a reference model that carries a steady moment, re-identified: the moment's value
+        // moves with θ, no effect is added — `written` says "refit", as the text does
+        let given = Model::new(1.0, vec![-0.3, 0.9], vec![0.5, 0.4], vec![0.2, 0.1])
+            .unwrap()
+            .with_effect(augment_effect(1.0));
+        let mut refit = given.clone();
+        refit.a[0] = -0.31;
+        refit.effects = vec![augment_effect(1.4)];
+        assert_eq!(written_kind(&given, &given), Written::Input);
+        assert_eq!(written_kind(&given, &refit), Written::Refit);
+        let added = refit
+            .clone()
+            .with_effect(yawcast::identify::model::Effect::DeadTime { samples: 2 });
+        assert_eq!(written_kind(&given, &added), Written::Augmented);
+    }
+
+    fn augment_effect(beta: f64) -> yawcast::identify::model::Effect {
+        yawcast::identify::model::Effect::Bias { beta }
+    }
 
     fn tried(effect: EffectKind, gain: f64, note: Option<&str>) -> augment::Tried {
         augment::Tried {

@@ -349,7 +349,16 @@ fn augment_auto_re_estimates_an_effect_the_model_carries_when_the_trials_change_
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(v["effect"], "bias", "{}", stdout(&o));
     assert_eq!(v["kept"], true, "{}", v["explanation"]);
-    assert_eq!(v["written"], "augmented");
+    // the structure re-identified, its own moment's value with θ: a refit, as the text says
+    assert_eq!(v["written"], "refit");
+    assert!(
+        v["explanation"]
+            .as_str()
+            .unwrap()
+            .contains("The model written is the input structure re-identified"),
+        "{}",
+        v["explanation"]
+    );
     assert_eq!(v["effects"], serde_json::json!(["bias"]));
     let (b10, a10) = (
         v["before"]["fit"]["10"].as_f64().unwrap(),
