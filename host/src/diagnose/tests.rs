@@ -234,7 +234,7 @@ fn speed_harmonics_see_a_current() {
 
 /// Records of a test world as `bench/worlds/run.sh` sails them: 1 800 s of the world's
 /// identification input with the suite's trial noise, the hidden effects given.
-fn world_records(
+pub(crate) fn world_records(
     kind: crate::sim::WorldKind,
     effects: Vec<SimEffect>,
     seeds: &[u64],

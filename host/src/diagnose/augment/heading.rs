@@ -49,7 +49,11 @@ pub(super) fn without_offset(model: &Model) -> Model {
 
 /// The report of a re-identification on shifted records as the candidate's: the model with
 /// the offset, which counts as one more parameter (its standard error the heading's, last,
-/// as a gain would be).
+/// as a gain would be). Its information criteria count the heading's evidence as well: the
+/// offset is measured on the heading, a channel the yaw-rate likelihood does not see, and
+/// there the offset at its estimate against none lowers −2 ln L by z² = (offset / se)²
+/// ([`heading_evidence`]) — so an offset the heading measures well is worth its parameter
+/// even where the yaw rate alone cannot tell it from a steady moment.
 pub(super) fn with_measured_offset(mut rep: PemReport, hb: HeadingBias) -> PemReport {
     rep.model = rep.model.with_effect(Effect::GyroBias { d_y: hb.bias });
     rep.names.push("d_y".into());
@@ -62,9 +66,21 @@ pub(super) fn with_measured_offset(mut rep: PemReport, hb: HeadingBias) -> PemRe
     let mut last = vec![0.0; p + 1];
     last[p] = hb.se * hb.se;
     rep.cov.push(last);
-    rep.aic += 2.0;
-    rep.bic += (rep.samples.max(1) as f64).ln();
+    let z2 = heading_evidence(hb);
+    rep.aic += 2.0 - z2;
+    rep.bic += (rep.samples.max(1) as f64).ln() - z2;
     rep
+}
+
+/// The heading's evidence for the offset `hb`: the drop in −2 ln L of its measurement,
+/// z² = (offset / se)² (0 where the standard error is not positive and finite).
+pub(super) fn heading_evidence(hb: HeadingBias) -> f64 {
+    let z = hb.bias / hb.se;
+    if hb.se > 0.0 && z.is_finite() {
+        z * z
+    } else {
+        0.0
+    }
 }
 
 /// The words of the search note.
@@ -72,8 +88,11 @@ pub(super) fn note(hb: HeadingBias) -> String {
     format!(
         "the offset held at what the heading measures, {:+.4} ± {:.4} °/s (the gyro against \
          the compass's turn; on the yaw rate alone a steady yaw moment looks the same), the \
-         model re-identified on the yaw rate less it",
-        hb.bias, hb.se
+         model re-identified on the yaw rate less it; the heading's evidence for it, \
+         z² = {:.1}, counts in ΔAIC and ΔBIC",
+        hb.bias,
+        hb.se,
+        heading_evidence(hb)
     )
 }
 

@@ -148,6 +148,13 @@ fn t_crit(dof: usize) -> f64 {
     crate::stats::student_t_quantile(0.05, dof as f64)
 }
 
+/// Mean held-out fit difference (pp) below which two models predict the same: half the
+/// printed resolution (0.01 pp). A model re-identified from another start — the offset held
+/// at the heading's measurement, the yaw rate shifted by it — predicts what the baseline
+/// does to a few ten-thousandths of a point, a spread so small that such a difference would
+/// otherwise read as significant.
+const ROUNDING_PP: f64 = 0.005;
+
 /// Paired gain statistics: (mean, standard error, t).
 fn paired(after: &[f64], base: &[f64]) -> (f64, f64, f64) {
     let g: Vec<f64> = after.iter().zip(base).map(|(a, b)| a - b).collect();
@@ -161,7 +168,10 @@ fn paired(after: &[f64], base: &[f64]) -> (f64, f64, f64) {
     }
     let var = g.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (k - 1) as f64;
     let se = (var / k as f64).sqrt();
-    let t = if se > 0.0 {
+    // a difference that prints as 0.00 pp is none, whatever its spread
+    let t = if m.abs() < ROUNDING_PP {
+        0.0
+    } else if se > 0.0 {
         m / se
     } else if m > 0.0 {
         f64::INFINITY
@@ -441,5 +451,37 @@ pub(super) fn judge(
         stable,
         reasons,
         kept,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_difference_that_prints_as_zero_is_none() {
+        // the Mariner gyro-offset case's held-out differences: a few ten-thousandths of a
+        // point with a spread smaller still, which a t-test alone calls significant
+        let base = [80.0, 81.0, 79.5];
+        let after: Vec<f64> = base
+            .iter()
+            .zip([-2.4e-4, -1.3e-4, -2.5e-4])
+            .map(|(b, d)| b + d)
+            .collect();
+        let (m, se, t) = paired(&after, &base);
+        assert!(m < 0.0 && se < 1e-3 && m.abs() / se > 2.0, "{m} {se}");
+        assert_eq!(t, 0.0);
+        // a real difference keeps its t
+        let after: Vec<f64> = base
+            .iter()
+            .zip([-0.5, -0.6, -0.4])
+            .map(|(b, d)| b + d)
+            .collect();
+        let (m, se, t) = paired(&after, &base);
+        assert!(
+            (m + 0.5).abs() < 1e-9 && (t - m / se).abs() < 1e-9,
+            "{m} {se} {t}"
+        );
+        assert!(t < -t_crit(2));
     }
 }
