@@ -191,7 +191,7 @@ pub(crate) fn log_of(r: &Record) -> String {
             s += &line(format!("HEHDT,{:.3},T", p[t].rem_euclid(360.0)));
         }
         if let (Some(v), Some(c)) = (&r.speed, &r.cog) {
-            let kn = v[t] / 0.514_444;
+            let kn = v[t] / knots(1.0);
             s += &line(format!(
                 "GPVTG,{:.3},T,,M,{kn:.4},N,{:.4},K,A",
                 c[t].rem_euclid(360.0),
