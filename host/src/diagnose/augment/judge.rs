@@ -155,6 +155,12 @@ fn t_crit(dof: usize) -> f64 {
 /// otherwise read as significant.
 const ROUNDING_PP: f64 = 0.005;
 
+/// Is held-out fit % `after` worse than `before`? Not by what prints as 0.00 pp
+/// ([`ROUNDING_PP`]): "91.5 < 91.5 %" is no reason.
+fn worse_fit(after: f64, before: f64) -> bool {
+    after < before - ROUNDING_PP
+}
+
 /// Paired gain statistics: (mean, standard error, t).
 fn paired(after: &[f64], base: &[f64]) -> (f64, f64, f64) {
     let g: Vec<f64> = after.iter().zip(base).map(|(a, b)| a - b).collect();
@@ -431,7 +437,7 @@ pub(super) fn judge(
         reasons.push(Reason::SignificantlyWorse(gains));
     }
     for k in ["10", "sim"] {
-        if get(after, k) < get(before, k) {
+        if worse_fit(get(after, k), get(before, k)) {
             reasons.push(Reason::WorseThanInput {
                 horizon: k.to_string(),
                 after: get(after, k),
@@ -483,5 +489,8 @@ mod tests {
             "{m} {se} {t}"
         );
         assert!(t < -t_crit(2));
+        // the same bound for "worse than the input model"
+        assert!(!worse_fit(91.5202, 91.5226));
+        assert!(worse_fit(91.5202, 91.5299));
     }
 }
