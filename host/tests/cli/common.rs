@@ -7,12 +7,37 @@ pub(crate) fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_yawcast"))
 }
 
-/// A fresh scratch directory per test.
-pub(crate) fn scratch(name: &str) -> PathBuf {
+/// A fresh scratch directory per test, removed when the test is done with it — kept when
+/// the test fails, for a look at what it wrote (its path is in the failure's messages).
+pub(crate) fn scratch(name: &str) -> Scratch {
     let d = std::env::temp_dir().join(format!("yawcast-cli-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
-    d
+    Scratch(d)
+}
+
+/// A scratch directory ([`scratch`]): a path that removes itself unless the test panicked.
+pub(crate) struct Scratch(PathBuf);
+
+impl std::ops::Deref for Scratch {
+    type Target = PathBuf;
+    fn deref(&self) -> &PathBuf {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        if !std::thread::panicking() {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
 }
 
 pub(crate) fn run(args: &[&str]) -> Output {
