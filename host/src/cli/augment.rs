@@ -761,22 +761,17 @@ mod tests {
     fn a_refit_of_a_model_with_its_own_moment_is_a_refit_not_an_augmentation() {
         // a reference model that carries a steady moment, re-identified: the moment's value
         // moves with θ, no effect is added — `written` says "refit", as the text does
+        use yawcast::identify::model::Effect;
         let given = Model::new(1.0, vec![-0.3, 0.9], vec![0.5, 0.4], vec![0.2, 0.1])
             .unwrap()
-            .with_effect(augment_effect(1.0));
+            .with_effect(Effect::Bias { beta: 1.0 });
         let mut refit = given.clone();
         refit.a[0] = -0.31;
-        refit.effects = vec![augment_effect(1.4)];
+        refit.effects = vec![Effect::Bias { beta: 1.4 }];
         assert_eq!(written_kind(&given, &given), Written::Input);
         assert_eq!(written_kind(&given, &refit), Written::Refit);
-        let added = refit
-            .clone()
-            .with_effect(yawcast::identify::model::Effect::DeadTime { samples: 2 });
+        let added = refit.clone().with_effect(Effect::DeadTime { samples: 2 });
         assert_eq!(written_kind(&given, &added), Written::Augmented);
-    }
-
-    fn augment_effect(beta: f64) -> yawcast::identify::model::Effect {
-        yawcast::identify::model::Effect::Bias { beta }
     }
 
     fn tried(effect: EffectKind, gain: f64, note: Option<&str>) -> augment::Tried {

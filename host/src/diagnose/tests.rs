@@ -299,9 +299,12 @@ fn the_anemometer_shows_wind_and_not_a_current() {
         ..Default::default()
     };
     let as_log = |recs: &[Record]| -> Vec<Record> {
-        let log = |r: &Record| crate::io::nmea::tests::log_of(r);
-        let read = |r: &Record| crate::io::nmea::parse_nmea(&log(r), "t.nmea".as_ref(), "t", &opts);
-        recs.iter().map(|r| read(r).unwrap()).collect()
+        recs.iter()
+            .map(|r| {
+                let log = crate::io::nmea::tests::log_of(r);
+                crate::io::nmea::parse_nmea(&log, "t.nmea".as_ref(), "t", &opts).unwrap()
+            })
+            .collect()
     };
     let b = anemometer_evidence(&as_log(&wind), &as_log(&reference)).expect("course read");
     let (s2, f2) = b.speed_from();

@@ -567,5 +567,4 @@ fn navigation_input_errors_name_row_and_column_and_jumps_are_counted() {
         );
         assert!(first.contains(want), "{name}: {first}");
     }
-    let _ = std::fs::remove_dir_all(&d);
 }
