@@ -95,7 +95,8 @@ pub struct Qemu {
     tx: Vec<u8>,
     rx: Vec<u8>,
     rx_pos: usize,
-    /// What the log file of this run is called (QEMU's stdout/stderr: defmt frames).
+    /// What the log file of this run is called (QEMU's stdout/stderr: defmt frames). It is
+    /// removed when the run is dropped, and kept when a test panics, for a look.
     pub log: PathBuf,
 }
 
@@ -245,6 +246,9 @@ impl Drop for Qemu {
                 .arg(self.child.id().to_string())
                 .status();
             let _ = self.child.wait();
+        }
+        if !std::thread::panicking() {
+            let _ = std::fs::remove_file(&self.log);
         }
     }
 }

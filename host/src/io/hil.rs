@@ -290,7 +290,8 @@ pub struct Device {
     tx: Vec<u8>,
     /// The model order the firmware runs (from its banner; 0 when unknown).
     pub order: u8,
-    /// Where QEMU's own output (defmt log) goes, when running under QEMU.
+    /// Where QEMU's own output (defmt log) goes, when running under QEMU: a file in the
+    /// temporary directory, removed when the device is dropped (kept if the thread panics).
     pub log: Option<PathBuf>,
     /// Samples sent ahead before reading answers (QEMU applies flow control on its socket,
     /// so it can take many; a board's UART is read one sample at a time).
@@ -343,7 +344,8 @@ impl Device {
                         let _ = c.wait();
                     }
                     return Err(link(format!(
-                        "QEMU did not open its UART on port {port}: {e}"
+                        "QEMU did not open its UART on port {port}: {e} (QEMU's output: {})",
+                        log.display()
                     )));
                 }
                 Err(_) => std::thread::sleep(Duration::from_millis(20)),
@@ -357,7 +359,14 @@ impl Device {
         d.child = child;
         d.log = Some(log);
         d.window = 32;
-        d.expect_banner()?;
+        if let Err(e) = d.expect_banner() {
+            // QEMU's own output says why the firmware did not start: kept, and named
+            let log = d.log.take().map(|l| l.display().to_string());
+            return Err(match (e, log) {
+                (HilError::Link(m), Some(l)) => link(format!("{m} (QEMU's output: {l})")),
+                (e, _) => e,
+            });
+        }
         Ok(d)
     }
 
@@ -618,6 +627,9 @@ impl Drop for Device {
                 let _ = c.kill();
             }
             let _ = c.wait();
+        }
+        if let Some(log) = self.log.take().filter(|_| !std::thread::panicking()) {
+            let _ = std::fs::remove_file(log);
         }
     }
 }
