@@ -6,10 +6,9 @@ use yawcast_shared::model::EffectKind;
 use super::channels::Channels;
 use super::compare::mean_fit;
 use super::evidence::{trial_stats, Set, Version};
-use super::rule::{compared_gains, outpredicts, GAIN_PP};
+use super::rule::{compared_gains, outpredicts, NO_GAIN_PP};
 use super::verdict::{effect_evidence, frozen_gain, rank, Evidence};
 use super::DiagnoseConfig;
-use crate::effects::{def, Channel};
 use crate::identify::model::{Effect, Model};
 use crate::identify::predict::Horizon;
 use crate::io::data::Record;
@@ -21,12 +20,9 @@ use crate::io::data::Record;
 /// (`nulls[i]` for `grids[i]`: the null of an effect's statistic depends on its grid and the
 /// records, not on what else the model carries). Current and wind share speed over ground's
 /// evidence, so beside either the other is not a second effect. The others are ranked by the
-/// first stage's rule ([`rank`]); the second effect is the first of them that is significant
-/// at `level` and improves prediction on `held` (estimation part, held-out part) by
-/// [`GAIN_PP`] or more — θ frozen leaves part of the first effect in the errors, which reads
-/// as its neighbour (a saturation's remainder as an asymmetry) without improving prediction
-/// — or that its own channel shows with no yaw-rate part (a gyro offset, a current from
-/// speed over ground alone); `None` without one. When that is current or wind and the other
+/// first stage's rule ([`rank`]); the second effect is the first of them that [`named_second`]
+/// accepts, its held-out gain measured on `held` (estimation part, held-out part); `None`
+/// without one. When that is current or wind and the other
 /// is significant too, the one that predicts the held-out records better at both horizons
 /// ([`outpredicts`]: the ranking rule's second clause) is named.
 #[allow(clippy::too_many_arguments)]
@@ -63,19 +59,15 @@ pub(super) fn second_effect(
         .map(|(&i, st)| effect_evidence(with_first, grids[i].0, st, &nulls[i], has_ref, cfg, ch))
         .collect();
     // the first stage's ranking, on the model with the first effect; then the first
-    // significant effect that improves held-out prediction by the ranking rule's GAIN_PP
-    // (what a second effect adds beside the first is judged on prediction, not on the
-    // statistic alone: θ frozen leaves part of the first in the errors), or that its own
-    // channel shows with nothing in the yaw rate to gain (a gyro offset from the heading, a
-    // current from speed over ground alone)
+    // effect `named_second` accepts
     let trial = Set::new(with_first, est);
     rank(with_first, &trial, &mut ev, &rest, level, cfg, ch);
     let before = mean_fit(with_first, held.1, &Horizon::REPORT);
     let est_set = Set::new(with_first, held.0);
     let pick = ev.iter().position(|e| {
-        e.p < level
-            && ((e.channel_material && (e.speed_only || def(e.kind).channel == Channel::Heading))
-                || frozen_gain(with_first, e, &est_set, held.1, &before, cfg.parallel).0 >= GAIN_PP)
+        named_second(e, level, || {
+            frozen_gain(with_first, e, &est_set, held.1, &before, cfg.parallel).0
+        })
     })?;
     // current or wind: the ranking rule's second clause between the two, as in the first
     // stage — the one that predicts the held-out records better at both horizons is named
@@ -106,4 +98,43 @@ pub(super) fn second_effect(
         }
     }
     Some(ev.swap_remove(pick))
+}
+
+/// Is `e` named as the second effect of a ranked verdict? It must be significant at `level`,
+/// and either its own channel must show it (`channel_material`: a gyro offset from the
+/// heading, a current or wind from speed over ground, course over ground, the anemometer —
+/// the channels that carry them, whatever the yaw rate gains) or it must improve held-out
+/// prediction (`held_out_gain`, pp, computed only when needed) by [`NO_GAIN_PP`] or more,
+/// the level below which the ranking rule counts an effect as not improving prediction. What
+/// a second effect adds beside the first is judged on prediction, not on the statistic
+/// alone: θ frozen leaves part of the first effect in the errors, which can read as its
+/// neighbour (a saturation's remainder as an asymmetry) without improving prediction.
+pub(super) fn named_second(e: &Evidence, level: f64, held_out_gain: impl FnOnce() -> f64) -> bool {
+    e.p < level && (e.channel_material || held_out_gain() >= NO_GAIN_PP)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnose::tests::evidence;
+
+    #[test]
+    fn a_second_effect_is_named_by_its_channel_or_by_what_it_wins_back() {
+        let level = 1e-3;
+        // a wind the speed over ground and the yaw moment's harmonics show (lng, a slew
+        // limit and wind hidden, seed 1: p 6e-14, +0.20 pp held out): its channels name it
+        let wind = evidence(EffectKind::Wind, 6e-14, 5e-7, true);
+        assert!(named_second(&wind, level, || 0.20));
+        // a damping beside a saturation (Mariner, seed 1: +0.69 pp at 10 steps, θ frozen)
+        let nld = evidence(EffectKind::NonlinearDamping, 3e-12, 3e-12, false);
+        assert!(named_second(&nld, level, || 0.69));
+        assert!(named_second(&nld, level, || NO_GAIN_PP));
+        // a remainder of the first effect that wins nothing back is not a second effect
+        assert!(!named_second(&nld, level, || 0.49));
+        assert!(!named_second(&nld, level, || f64::NEG_INFINITY));
+        // nor is an effect that is not significant, whatever it gains: its held-out
+        // gain is not even computed
+        let weak = evidence(EffectKind::NonlinearDamping, 2e-3, 2e-3, true);
+        assert!(!named_second(&weak, level, || unreachable!("not computed")));
+    }
 }

@@ -554,7 +554,7 @@ fn missing_heading_and_speed_are_said() {
     assert!(d.reference_used);
 }
 
-fn evidence(kind: EffectKind, p: f64, p_yaw: f64, channel_material: bool) -> Evidence {
+pub(super) fn evidence(kind: EffectKind, p: f64, p_yaw: f64, channel_material: bool) -> Evidence {
     Evidence {
         kind,
         h: SLOW_HORIZON,
