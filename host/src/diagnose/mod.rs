@@ -507,15 +507,15 @@ pub fn diagnose(
             (&est_part, &held_out),
         )
     });
-    if let Some(e) = &then {
+    if let Some((e, why)) = &then {
         explanation.push_str(&format!(
-            " Then, against the model with it: {} ({}; p {}).",
+            " Then, against the model with it: {} ({}; p {}; {why}).",
             effect_phrase(e.kind),
             e.kind.name(),
             verdict::fmt_p(e.p)
         ));
     }
-    let then = then.map(|e| e.kind.name().to_string());
+    let then = then.map(|(e, _)| e.kind.name().to_string());
     for c in &caveats {
         explanation.push(' ');
         explanation.push_str(&c.explain());

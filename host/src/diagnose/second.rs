@@ -24,7 +24,8 @@ use crate::io::data::Record;
 /// accepts, its held-out gain measured on `held` (estimation part, held-out part); `None`
 /// without one. When that is current or wind and the other
 /// is significant too, the one that predicts the held-out records better at both horizons
-/// ([`outpredicts`]: the ranking rule's second clause) is named.
+/// ([`outpredicts`]: the ranking rule's second clause) is named. Beside the effect, why it is
+/// named, in words (its channel, its held-out gain, or the second clause).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn second_effect(
     base: &Model,
@@ -38,7 +39,7 @@ pub(super) fn second_effect(
     cfg: &DiagnoseConfig,
     ch: &Channels,
     held: (&[Record], &[Record]),
-) -> Option<Evidence> {
+) -> Option<(Evidence, String)> {
     let k1 = first.kind();
     let with_first = &base.clone().with_effect(*first);
     let shares_speed = |k: EffectKind| {
@@ -64,9 +65,11 @@ pub(super) fn second_effect(
     rank(with_first, &trial, &mut ev, &rest, level, cfg, ch);
     let before = mean_fit(with_first, held.1, &Horizon::REPORT);
     let est_set = Set::new(with_first, held.0);
+    let mut gain = f64::NAN;
     let pick = ev.iter().position(|e| {
         named_second(e, level, || {
-            frozen_gain(with_first, e, &est_set, held.1, &before, cfg.parallel).0
+            gain = frozen_gain(with_first, e, &est_set, held.1, &before, cfg.parallel).0;
+            gain
         })
     })?;
     // current or wind: the ranking rule's second clause between the two, as in the first
@@ -94,10 +97,20 @@ pub(super) fn second_effect(
                 gp[1]
             );
             ev[j].words.push_str(&words);
-            return Some(ev.swap_remove(j));
+            let why = format!(
+                "named ahead of {}: it predicts the held-out records better at 10 steps and in \
+                 simulation",
+                ev[pick].kind.name()
+            );
+            return Some((ev.swap_remove(j), why));
         }
     }
-    Some(ev.swap_remove(pick))
+    let why = if ev[pick].channel_material {
+        "its own channel shows it".to_string()
+    } else {
+        format!("held-out fit gain {gain:+.2} pp")
+    };
+    Some((ev.swap_remove(pick), why))
 }
 
 /// Is `e` named as the second effect of a ranked verdict? It must be significant at `level`,

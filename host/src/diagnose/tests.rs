@@ -854,7 +854,17 @@ fn a_second_effect_is_measured_against_the_model_with_the_first() {
         "{}",
         d.explanation
     );
-    assert!(d.explanation.contains("Then, against the model with it"));
+    // and why it is named: what it wins back held out (θ frozen), at least NO_GAIN_PP
+    let then = d
+        .explanation
+        .split("Then, against the model with it")
+        .nth(1);
+    let gain: f64 = then
+        .and_then(|t| t.split("held-out fit gain ").nth(1))
+        .and_then(|t| t.split(" pp").next())
+        .and_then(|g| g.parse().ok())
+        .unwrap_or_else(|| panic!("no held-out gain for the second: {}", d.explanation));
+    assert!(gain >= rule::NO_GAIN_PP, "{gain} {}", d.explanation);
     // the saturation alone: nothing second
     let one = records(Some((EffectKind::Saturation, 1.0)), &[40, 41, 42]);
     let d = diagnose(&model, &refs, &one, &[], &cfg).unwrap();
