@@ -360,11 +360,13 @@ impl Device {
         d.log = Some(log);
         d.window = 32;
         if let Err(e) = d.expect_banner() {
-            // QEMU's own output says why the firmware did not start: kept, and named
-            let log = d.log.take().map(|l| l.display().to_string());
-            return Err(match (e, log) {
-                (HilError::Link(m), Some(l)) => link(format!("{m} (QEMU's output: {l})")),
-                (e, _) => e,
+            return Err(match e {
+                // QEMU's own output says why the firmware did not start: kept, and named
+                HilError::Link(m) => match d.log.take() {
+                    Some(l) => link(format!("{m} (QEMU's output: {})", l.display())),
+                    None => link(m),
+                },
+                e => e,
             });
         }
         Ok(d)
