@@ -136,6 +136,19 @@ pub(super) fn outpredicts(a: [f64; 2], b: [f64; 2]) -> bool {
     a[0] > b[0] && a[1] > b[1] && (a[0] - b[0] >= NO_GAIN_PP || a[1] - b[1] >= NO_GAIN_PP)
 }
 
+/// May a current or wind its channels show (gains `gi` at the [`COMPARED`] horizons) be named
+/// behind an effect no channel shows (gains `gj`)? Only when that one predicts the held-out
+/// records better by [`GAIN_PP`] or more at both horizons: the yaw-moment test that tells wind
+/// from current was then measured against a model missing the larger effect (the built-in
+/// ship, a slew limit and wind hidden, seed 3: a current at +0.15 / +1.23 pp ahead of the
+/// slew limit at +50.0 / +37.6, the wind's moment p = 0.46 there), and the ranked verdict's
+/// second stage decides it against the model with the larger one.
+fn carried_behind(kind: EffectKind, gi: [f64; 2], gj: [f64; 2]) -> bool {
+    matches!(kind, EffectKind::Current | EffectKind::Wind)
+        && gj[0] - gi[0] >= GAIN_PP
+        && gj[1] - gi[1] >= GAIN_PP
+}
+
 /// An effect the ranking rule passed over for one that predicts the held-out records better
 /// at both horizons ([`outpredicted`]).
 #[derive(Debug, Clone, Copy)]
@@ -158,7 +171,8 @@ pub(super) struct Outpredicted {
 /// wind's heading-dependent moment and a current's) can rank by the horizon that favours one
 /// while the other predicts better on both; the held-out records at both horizons are the
 /// common yardstick. An effect its own channel shows (heading, speed over ground) is not
-/// displaced by one no channel shows. Applied to the first material effect (as
+/// displaced by one no channel shows — but for a current or wind that the other outpredicts
+/// by [`GAIN_PP`] at both horizons ([`carried_behind`]). Applied to the first material effect (as
 /// [`super::verdict::ranked`] names it) until none outpredicts it (`before`: the held-out
 /// fits without any effect); returns the first effect passed over.
 pub(super) fn outpredicted(
@@ -171,13 +185,25 @@ pub(super) fn outpredicted(
     for _ in 0..ev.len() {
         let i = first_material(ev, gains)?;
         let gi = gains_at(&gains[i], before)?;
-        let j = (i + 1..ev.len())
-            .filter(|&j| ev[j].channel_material >= ev[i].channel_material)
+        let better: Vec<(usize, [f64; 2])> = (i + 1..ev.len())
             // itself material, so that it is what is named
             .filter(|&j| is_material(ev, gains, j))
             .filter_map(|j| Some((j, gains_at(&gains[j], before)?)))
             .filter(|&(_, gj)| outpredicts(gj, gi))
-            .max_by(|a, b| (a.1[0] + a.1[1]).total_cmp(&(b.1[0] + b.1[1])));
+            .collect();
+        // the one that predicts best; a current or wind carried behind an effect no channel
+        // shows goes behind the first such in the ranking's own order (statistic and
+        // encompassing test: a dead time ahead of the slow gear that mimics it)
+        let j = better
+            .iter()
+            .filter(|&&(j, _)| ev[j].channel_material >= ev[i].channel_material)
+            .max_by(|a, b| (a.1[0] + a.1[1]).total_cmp(&(b.1[0] + b.1[1])))
+            .or_else(|| {
+                better
+                    .iter()
+                    .find(|&&(_, gj)| carried_behind(ev[i].kind, gi, gj))
+            })
+            .copied();
         let Some((j, gj)) = j else {
             return first;
         };
@@ -206,4 +232,75 @@ pub(super) fn outpredicted(
         move_ahead(ev, gains, i, j, &words);
     }
     first
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnose::tests::evidence;
+
+    #[test]
+    fn a_current_is_named_behind_an_effect_that_predicts_far_better() {
+        let before: Fits = [("10".to_string(), 36.0), ("sim".to_string(), 44.0)]
+            .into_iter()
+            .collect();
+        let held = |g10: f64, gsim: f64, own: f64| {
+            let fits: Fits = [
+                ("10".to_string(), 36.0 + g10),
+                ("sim".to_string(), 44.0 + gsim),
+            ]
+            .into_iter()
+            .collect();
+            Some((own, fits))
+        };
+        let run = |cur: (f64, f64), gear: (f64, f64)| {
+            let mut ev = vec![
+                evidence(EffectKind::Current, 5e-12, 0.46, true),
+                evidence(EffectKind::RateLimit, 0.0, 0.0, false),
+            ];
+            let mut gains = vec![held(cur.0, cur.1, cur.1), held(gear.0, gear.1, gear.0)];
+            let o = outpredicted(&mut ev, &mut gains, &before);
+            (o.map(|o| (o.kind, o.by)), ev[0].kind)
+        };
+        // the built-in ship, a slew limit and wind hidden, seed 3
+        let (o, first) = run((0.15, 1.23), (49.96, 37.58));
+        assert_eq!(o, Some((EffectKind::Current, EffectKind::RateLimit)));
+        assert_eq!(first, EffectKind::RateLimit);
+        // behind the first of two that qualify, in the ranking's order, not the one with
+        // the larger gains (KVLCC2, a dead time and a current hidden, seed 2: the dead time
+        // ahead of the slow gear that mimics it)
+        let mut ev = vec![
+            evidence(EffectKind::Current, 0.0, 0.9, true),
+            evidence(EffectKind::DeadTime, 0.0, 0.0, false),
+            evidence(EffectKind::RateLimit, 0.0, 0.0, false),
+        ];
+        let mut gains = vec![
+            held(0.00, 0.51, 0.51),
+            held(12.42, 13.38, 12.42),
+            held(11.56, 14.91, 11.56),
+        ];
+        let o = outpredicted(&mut ev, &mut gains, &before).expect("moved");
+        assert_eq!((o.kind, o.by), (EffectKind::Current, EffectKind::DeadTime));
+        let kinds: Vec<EffectKind> = ev.iter().map(|e| e.kind).collect();
+        assert_eq!(
+            kinds,
+            [
+                EffectKind::DeadTime,
+                EffectKind::Current,
+                EffectKind::RateLimit
+            ]
+        );
+        // better by less than GAIN_PP at one horizon: the channel keeps its place
+        for gear in [(1.10, 2.00), (5.0, 2.20)] {
+            let (o, first) = run((0.15, 1.23), gear);
+            assert_eq!((o, first), (None, EffectKind::Current), "{gear:?}");
+        }
+        // a gyro offset its heading shows is not carried behind anything
+        assert!(!carried_behind(
+            EffectKind::GyroBias,
+            [0.0, 0.0],
+            [50.0, 40.0]
+        ));
+        assert!(carried_behind(EffectKind::Wind, [0.0, 0.0], [1.0, 1.0]));
+    }
 }
