@@ -65,12 +65,11 @@ pub(super) fn second_effect(
     rank(with_first, &trial, &mut ev, &rest, level, cfg, ch);
     let before = mean_fit(with_first, held.1, &Horizon::REPORT);
     let est_set = Set::new(with_first, held.0);
-    let mut gain = f64::NAN;
-    let pick = ev.iter().position(|e| {
+    let (pick, named) = ev.iter().enumerate().find_map(|(i, e)| {
         named_second(e, level, || {
-            gain = frozen_gain(with_first, e, &est_set, held.1, &before, cfg.parallel).0;
-            gain
+            frozen_gain(with_first, e, &est_set, held.1, &before, cfg.parallel).0
         })
+        .map(|n| (i, n))
     })?;
     // current or wind: the ranking rule's second clause between the two, as in the first
     // stage — the one that predicts the held-out records better at both horizons is named
@@ -105,25 +104,50 @@ pub(super) fn second_effect(
             return Some((ev.swap_remove(j), why));
         }
     }
-    let why = if ev[pick].channel_material {
-        "its own channel shows it".to_string()
-    } else {
-        format!("held-out fit gain {gain:+.2} pp")
-    };
-    Some((ev.swap_remove(pick), why))
+    Some((ev.swap_remove(pick), named.to_string()))
 }
 
-/// Is `e` named as the second effect of a ranked verdict? It must be significant at `level`,
-/// and either its own channel must show it (`channel_material`: a gyro offset from the
-/// heading, a current or wind from speed over ground, course over ground, the anemometer —
-/// the channels that carry them, whatever the yaw rate gains) or it must improve held-out
-/// prediction (`held_out_gain`, pp, computed only when needed) by [`NO_GAIN_PP`] or more,
-/// the level below which the ranking rule counts an effect as not improving prediction. What
-/// a second effect adds beside the first is judged on prediction, not on the statistic
-/// alone: θ frozen leaves part of the first effect in the errors, which can read as its
-/// neighbour (a saturation's remainder as an asymmetry) without improving prediction.
-pub(super) fn named_second(e: &Evidence, level: f64, held_out_gain: impl FnOnce() -> f64) -> bool {
-    e.p < level && (e.channel_material || held_out_gain() >= NO_GAIN_PP)
+/// Why a second effect is named ([`named_second`]); its `Display` is the explanation's words.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Named {
+    /// Its own channel shows it.
+    Channel,
+    /// It improves held-out prediction by this many pp (≥ [`NO_GAIN_PP`]).
+    Gain(f64),
+}
+
+impl core::fmt::Display for Named {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Named::Channel => f.write_str("its own channel shows it"),
+            Named::Gain(g) => write!(f, "held-out fit gain {g:+.2} pp"),
+        }
+    }
+}
+
+/// Is `e` named as the second effect of a ranked verdict, and why? It must be significant
+/// at `level`, and either its own channel must show it (`channel_material`: a gyro offset
+/// from the heading, a current or wind from speed over ground, course over ground, the
+/// anemometer — the channels that carry them, whatever the yaw rate gains) or it must
+/// improve held-out prediction (`held_out_gain`, pp, computed only when needed) by
+/// [`NO_GAIN_PP`] or more, the level below which the ranking rule counts an effect as not
+/// improving prediction. What a second effect adds beside the first is judged on
+/// prediction, not on the statistic alone: θ frozen leaves part of the first effect in the
+/// errors, which can read as its neighbour (a saturation's remainder as an asymmetry)
+/// without improving prediction.
+pub(super) fn named_second(
+    e: &Evidence,
+    level: f64,
+    held_out_gain: impl FnOnce() -> f64,
+) -> Option<Named> {
+    if e.p >= level {
+        return None;
+    }
+    if e.channel_material {
+        return Some(Named::Channel);
+    }
+    let g = held_out_gain();
+    (g >= NO_GAIN_PP).then_some(Named::Gain(g))
 }
 
 #[cfg(test)]
@@ -137,17 +161,25 @@ mod tests {
         // a wind the speed over ground and the yaw moment's harmonics show (lng, a slew
         // limit and wind hidden, seed 1: p 6e-14, +0.20 pp held out): its channels name it
         let wind = evidence(EffectKind::Wind, 6e-14, 5e-7, true);
-        assert!(named_second(&wind, level, || 0.20));
+        let named = named_second(&wind, level, || unreachable!("its channels name it"));
+        assert_eq!(named, Some(Named::Channel));
+        assert_eq!(named.unwrap().to_string(), "its own channel shows it");
         // a damping beside a saturation (Mariner, seed 1: +0.69 pp at 10 steps, θ frozen)
         let nld = evidence(EffectKind::NonlinearDamping, 3e-12, 3e-12, false);
-        assert!(named_second(&nld, level, || 0.69));
-        assert!(named_second(&nld, level, || NO_GAIN_PP));
-        // a remainder of the first effect that wins nothing back is not a second effect
-        assert!(!named_second(&nld, level, || 0.49));
-        assert!(!named_second(&nld, level, || f64::NEG_INFINITY));
+        let named = named_second(&nld, level, || 0.69);
+        assert_eq!(named, Some(Named::Gain(0.69)));
+        assert_eq!(named.unwrap().to_string(), "held-out fit gain +0.69 pp");
+        let at = named_second(&nld, level, || NO_GAIN_PP);
+        assert_eq!(at, Some(Named::Gain(NO_GAIN_PP)));
+        // a remainder of the first effect that wins nothing back is not a second effect,
+        // nor one whose gain could not be measured
+        assert_eq!(named_second(&nld, level, || 0.49), None);
+        assert_eq!(named_second(&nld, level, || f64::NEG_INFINITY), None);
+        assert_eq!(named_second(&nld, level, || f64::NAN), None);
         // nor is an effect that is not significant, whatever it gains: its held-out
         // gain is not even computed
         let weak = evidence(EffectKind::NonlinearDamping, 2e-3, 2e-3, true);
-        assert!(!named_second(&weak, level, || unreachable!("not computed")));
+        let none = named_second(&weak, level, || unreachable!("not computed"));
+        assert_eq!(none, None);
     }
 }
