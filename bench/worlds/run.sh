@@ -25,9 +25,10 @@
 #                     100·s + 50, the trials' noise) with the world's own 10-step predictor
 #                     (`simulate --oracle-horizon 10`), scored at 10 steps (`compare`) for
 #                     the best linear model (the better of the reference model and one
-#                     identified on the trials) and for the model `augment --effect auto`
-#                     writes; won back = (augmented − linear) / (oracle − linear) where the
-#                     linear model is ≥ 3 pp below the oracle (median per world and strength)
+#                     identified on the trials) and for the models `augment --effect auto`
+#                     writes without and with `--more`; won back = (augmented − linear) /
+#                     (oracle − linear) where the linear model is ≥ 3 pp below the oracle
+#                     (median per world and strength)
 #
 # Per world: the reference is 3 records of the world's identification input (seeds 900–902,
 # gyro noise 0.02 °/s, heading noise 0.1°) and the model identified on them; each case is 3
@@ -137,11 +138,14 @@ print(json.load(open(sys.argv[1]))["records"][0]["fit"]["10"])'
                 >>"$dir/won-back.log" 2>&1 \
             && "$YAWCAST" augment --model "$WORK/$world/ref.postcard" --effect auto \
                 "${refs[@]}" "${data[@]}" --seed "$seed" --out "$dir/won" \
+                >>"$dir/won-back.log" 2>&1 \
+            && "$YAWCAST" augment --model "$WORK/$world/ref.postcard" --effect auto --more \
+                "${refs[@]}" "${data[@]}" --seed "$seed" --out "$dir/more" \
                 >>"$dir/won-back.log" 2>&1; then
-            local o l r a ok=1
+            local o l r a m ok=1
             o=$(python3 -c 'import json,sys
 print(json.load(open(sys.argv[1]))["records"][0]["oracle_fit_pct"])' "$dir/val.json")
-            for m in linear ref won; do
+            for m in linear ref won more; do
                 local path="$dir/$m.postcard"
                 [ "$m" = ref ] && path="$WORK/$world/ref.postcard"
                 "$YAWCAST" compare --model "$path" --data "$dir/val.csv" --horizons 10 \
@@ -151,9 +155,10 @@ print(json.load(open(sys.argv[1]))["records"][0]["oracle_fit_pct"])' "$dir/val.j
                 l=$(python3 -c "$fit10" "$dir/val-linear.json")
                 r=$(python3 -c "$fit10" "$dir/val-ref.json")
                 a=$(python3 -c "$fit10" "$dir/val-won.json")
+                m=$(python3 -c "$fit10" "$dir/val-more.json")
                 fits=$(python3 -c 'import sys
-o, l, r, a = map(float, sys.argv[1:])
-print(f"{o:.2f}/{max(l, r):.2f}/{a:.2f}")' "$o" "$l" "$r" "$a")
+o, l, r, a, m = map(float, sys.argv[1:])
+print(f"{o:.2f}/{max(l, r):.2f}/{a:.2f}/{m:.2f}")' "$o" "$l" "$r" "$a" "$m")
             fi
         fi
     fi
@@ -240,22 +245,26 @@ won = [r for r in rows if len(r) > 7 and r[7] not in ("-", "error") and r[2] != 
 if won:
     import statistics
     def parts(r):
-        return tuple(map(float, r[7].split("/")))
+        """oracle, best linear, augment --effect auto, and --more (None in older runs)."""
+        v = list(map(float, r[7].split("/")))
+        return tuple(v + [None] * (4 - len(v)))
     print("\n## Error won back at 10 steps (validation record; oracle = the world's own predictor)\n")
     print("Loss = oracle − best linear; won back = (augmented − linear) / loss over the cases "
           "whose loss is ≥ 3 pp. Net: the loss less the world's own gap on effect-free trials "
           "(median oracle − linear of its `none` cases: the hull's nonlinearity and the state "
-          "the oracle knows and a model must estimate), over the cases whose net loss is ≥ 3 pp.\n")
+          "the oracle knows and a model must estimate), over the cases whose net loss is ≥ 3 pp. "
+          "With --more: the model `augment --effect auto --more` writes, over the same cases.\n")
     print("| world | strength | cases | loss ≥ 3 pp | median loss (pp) | median won back | ≥ 60 % |"
-          " effect-free gap (pp) | net loss ≥ 3 pp | median won back of the net loss | ≥ 60 % |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+          " effect-free gap (pp) | net loss ≥ 3 pp | median won back of the net loss | ≥ 60 % |"
+          " median won back with --more | ≥ 60 % |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for w in worlds:
         base = [parts(r) for r in rows if r[0] == w and r[2] == "none" and len(r) > 7
                 and r[7] not in ("-", "error")]
-        gap0 = statistics.median(o - l for o, l, _ in base) if base else None
+        gap0 = statistics.median(o - l for o, l, _, _ in base) if base else None
         for st in sorted({r[1] for r in won if r[0] == w}, key=float, reverse=True):
             cs = [parts(r) for r in won if r[0] == w and r[1] == st]
-            lost = [(o - l, 100.0 * (a - l) / (o - l)) for o, l, a in cs if o - l >= 3.0]
+            lost = [(o - l, 100.0 * (a - l) / (o - l)) for o, l, a, _ in cs if o - l >= 3.0]
             line = (f"| {w} | {st} | {len(cs)} | {len(lost)} | "
                     + (f"{statistics.median(x[0] for x in lost):.1f} | "
                        f"{statistics.median(x[1] for x in lost):.0f} % | " if lost else "– | – | ")
@@ -263,12 +272,18 @@ if won:
             if gap0 is None:
                 line += " – | – | – | – |"
             else:
-                net = [100.0 * (a - l) / (o - l - gap0) for o, l, a in cs if o - l - gap0 >= 3.0]
+                net = [100.0 * (a - l) / (o - l - gap0) for o, l, a, _ in cs
+                       if o - l - gap0 >= 3.0]
                 line += (f" {gap0:.1f} | {len(net)} | "
                          + (f"{statistics.median(net):.0f} % |" if net else "– |")
                          + f" {sum(x >= 60 for x in net)}/{len(net)} |")
+            more = [100.0 * (m - l) / (o - l) for o, l, _, m in cs
+                    if o - l >= 3.0 and m is not None]
+            line += ((f" {statistics.median(more):.0f} % | {sum(x >= 60 for x in more)}/{len(more)} |")
+                     if more else " – | – |")
             print(line)
-    print("\nPer case (oracle / best linear / augment --effect auto, fit % at 10 steps):\n")
+    print("\nPer case (oracle / best linear / augment --effect auto / with --more, fit % at 10 "
+          "steps):\n")
     for w in worlds:
         for st in sorted({r[1] for r in rows if r[0] == w and len(r) > 7 and r[7] != "-"}, key=float, reverse=True):
             print(f"- {w}, strength {st}: " + "; ".join(f"{r[2]} s{r[3]} {r[7]}" for r in rows
