@@ -430,7 +430,7 @@ pub fn diagnose(
         .collect();
     yaw_before_speed(&mut ev, &mut gains);
     let passed_over = gain_before_statistic(&mut ev, &mut gains);
-    let outpredicted = outpredicted(&mut ev, &mut gains, &base_before);
+    let outpredicted = outpredicted(&mut ev, &mut gains, &base_before, ch.anemometer.is_some());
     bar.inc(1);
     bar.set_message("refit with the verdict's effect");
     let (mut ranking, verdict) = ranked(&ev, &gains, level, &base_before);

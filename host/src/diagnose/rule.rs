@@ -149,6 +149,20 @@ fn carried_behind(kind: EffectKind, gi: [f64; 2], gj: [f64; 2]) -> bool {
         && gj[1] - gi[1] >= GAIN_PP
 }
 
+/// Are `a` and `b` current and wind, which an anemometer tells apart by the true wind it
+/// measures (a current carries ship and anemometer alike and leaves none)? Held-out yaw-rate
+/// prediction does not overturn that measurement: where the yaw channel shows no
+/// heading-dependent moment, the wind's four moment harmonics fitted on the estimation part
+/// only lose on the held-out part (Mariner, a half-strength wind hidden, seed 2: the
+/// anemometer's true wind 7.26 m/s from 45°, p < 10⁻¹⁶; the wind −0.08 / −1.40 pp against the
+/// current's +0.00 / +0.08 at 10 steps / in simulation, which named `current`).
+pub(super) fn anemometer_decides(a: EffectKind, b: EffectKind) -> bool {
+    matches!(
+        (a, b),
+        (EffectKind::Current, EffectKind::Wind) | (EffectKind::Wind, EffectKind::Current)
+    )
+}
+
 /// An effect the ranking rule passed over for one that predicts the held-out records better
 /// at both horizons ([`outpredicted`]).
 #[derive(Debug, Clone, Copy)]
@@ -172,13 +186,15 @@ pub(super) struct Outpredicted {
 /// while the other predicts better on both; the held-out records at both horizons are the
 /// common yardstick. An effect its own channel shows (heading, speed over ground) is not
 /// displaced by one no channel shows — but for a current or wind that the other outpredicts
-/// by [`GAIN_PP`] at both horizons ([`carried_behind`]). Applied to the first material effect (as
-/// [`super::verdict::ranked`] names it) until none outpredicts it (`before`: the held-out
-/// fits without any effect); returns the first effect passed over.
+/// by [`GAIN_PP`] at both horizons ([`carried_behind`]). Between current and wind an
+/// `anemometer` decides, not prediction ([`anemometer_decides`]). Applied to the first
+/// material effect (as [`super::verdict::ranked`] names it) until none outpredicts it
+/// (`before`: the held-out fits without any effect); returns the first effect passed over.
 pub(super) fn outpredicted(
     ev: &mut Vec<Evidence>,
     gains: &mut Vec<HeldOut>,
     before: &Fits,
+    anemometer: bool,
 ) -> Option<Outpredicted> {
     let mut first = None;
     // strict at both horizons: no cycle, at most one move per effect
@@ -188,6 +204,7 @@ pub(super) fn outpredicted(
         let better: Vec<(usize, [f64; 2])> = (i + 1..ev.len())
             // itself material, so that it is what is named
             .filter(|&j| is_material(ev, gains, j))
+            .filter(|&j| !(anemometer && anemometer_decides(ev[i].kind, ev[j].kind)))
             .filter_map(|j| Some((j, gains_at(&gains[j], before)?)))
             .filter(|&(_, gj)| outpredicts(gj, gi))
             .collect();
@@ -259,7 +276,7 @@ mod tests {
                 evidence(EffectKind::RateLimit, 0.0, 0.0, false),
             ];
             let mut gains = vec![held(cur.0, cur.1, cur.1), held(gear.0, gear.1, gear.0)];
-            let o = outpredicted(&mut ev, &mut gains, &before);
+            let o = outpredicted(&mut ev, &mut gains, &before, false);
             (o.map(|o| (o.kind, o.by)), ev[0].kind)
         };
         // the built-in ship, a slew limit and wind hidden, seed 3
@@ -279,7 +296,7 @@ mod tests {
             held(12.42, 13.38, 12.42),
             held(11.56, 14.91, 11.56),
         ];
-        let o = outpredicted(&mut ev, &mut gains, &before).expect("moved");
+        let o = outpredicted(&mut ev, &mut gains, &before, false).expect("moved");
         assert_eq!((o.kind, o.by), (EffectKind::Current, EffectKind::DeadTime));
         let kinds: Vec<EffectKind> = ev.iter().map(|e| e.kind).collect();
         assert_eq!(
@@ -302,5 +319,44 @@ mod tests {
             [50.0, 40.0]
         ));
         assert!(carried_behind(EffectKind::Wind, [0.0, 0.0], [1.0, 1.0]));
+    }
+
+    #[test]
+    fn an_anemometer_decides_between_current_and_wind_not_prediction() {
+        // Mariner, a half-strength wind hidden, seed 2, the anemometer logged: the true
+        // wind puts wind first; its moment harmonics lose held out, the current's do not
+        let before: Fits = [("10".to_string(), 85.0), ("sim".to_string(), 75.0)]
+            .into_iter()
+            .collect();
+        let held = |g10: f64, gsim: f64| {
+            let fits: Fits = [
+                ("10".to_string(), 85.0 + g10),
+                ("sim".to_string(), 75.0 + gsim),
+            ]
+            .into_iter()
+            .collect();
+            Some((g10, fits))
+        };
+        let run = |anemometer: bool| {
+            let mut ev = vec![
+                evidence(EffectKind::Wind, 1e-17, 0.63, true),
+                evidence(EffectKind::Current, 2.2e-4, 0.43, true),
+            ];
+            let mut gains = vec![held(-0.08, -1.40), held(0.00, 0.08)];
+            let o = outpredicted(&mut ev, &mut gains, &before, anemometer);
+            (o.map(|o| (o.kind, o.by)), ev[0].kind)
+        };
+        assert_eq!(run(true), (None, EffectKind::Wind));
+        // without one, the yaw moment is the witness and prediction the yardstick
+        assert_eq!(
+            run(false),
+            (
+                Some((EffectKind::Wind, EffectKind::Current)),
+                EffectKind::Current
+            )
+        );
+        assert!(anemometer_decides(EffectKind::Current, EffectKind::Wind));
+        assert!(!anemometer_decides(EffectKind::Wind, EffectKind::Asymmetry));
+        assert!(!anemometer_decides(EffectKind::Wind, EffectKind::Wind));
     }
 }

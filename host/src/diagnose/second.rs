@@ -24,7 +24,8 @@ use crate::io::data::Record;
 /// accepts, its held-out gain measured on `held` (estimation part, held-out part); `None`
 /// without one. When that is current or wind and the other is significant too, the one that
 /// predicts the held-out records better at both horizons ([`outpredicts`]: the ranking rule's
-/// second clause) is named. Beside the effect, why it is named, in words (its channel, its
+/// second clause) is named — unless the records log the anemometer, whose true wind decides
+/// between them as in the first stage ([`super::rule::anemometer_decides`]). Beside the effect, why it is named, in words (its channel, its
 /// held-out gain, or the second clause).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn second_effect(
@@ -72,12 +73,14 @@ pub(super) fn second_effect(
         .map(|n| (i, n))
     })?;
     // current or wind: the ranking rule's second clause between the two, as in the first
-    // stage — the one that predicts the held-out records better at both horizons is named
+    // stage — the one that predicts the held-out records better at both horizons is named;
+    // an anemometer decides between them instead (`anemometer_decides`)
     let partner = match ev[pick].kind {
         EffectKind::Current => Some(EffectKind::Wind),
         EffectKind::Wind => Some(EffectKind::Current),
         _ => None,
-    };
+    }
+    .filter(|_| ch.anemometer.is_none());
     if let Some(j) = partner.and_then(|k| ev.iter().position(|e| e.kind == k && e.p < level)) {
         let held_out = |e: &Evidence| {
             let (_, fits) = frozen_gain(with_first, e, &est_set, held.1, &before, cfg.parallel);

@@ -674,7 +674,7 @@ fn an_effect_that_predicts_worse_at_both_horizons_is_named_behind() {
         evidence(EffectKind::Asymmetry, 5e-21, 5e-21, false),
     ];
     let mut gains = vec![held(0.50, 7.20, 7.20), held(1.82, 9.61, 1.82)];
-    let o = outpredicted(&mut ev, &mut gains, &before).expect("moved");
+    let o = outpredicted(&mut ev, &mut gains, &before, false).expect("moved");
     assert_eq!((o.kind, o.by), (EffectKind::Bias, EffectKind::Asymmetry));
     assert!((o.gains[1] - 7.20).abs() < 1e-9 && (o.by_gains[0] - 1.82).abs() < 1e-9);
     assert_eq!(ev[0].kind, EffectKind::Asymmetry);
@@ -701,7 +701,7 @@ fn an_effect_that_predicts_worse_at_both_horizons_is_named_behind() {
         ];
         let mut gains = vec![held(a.0, a.1, a.1), held(b.0, b.1, b.0)];
         assert!(
-            outpredicted(&mut ev, &mut gains, &before).is_none(),
+            outpredicted(&mut ev, &mut gains, &before, false).is_none(),
             "{a:?} {b:?}"
         );
         assert_eq!(ev[0].kind, EffectKind::Bias);
@@ -714,7 +714,7 @@ fn an_effect_that_predicts_worse_at_both_horizons_is_named_behind() {
         evidence(EffectKind::Wind, 0.5, 0.5, false),
     ];
     let mut gains = vec![held(0.1, 6.3, 6.3), held(0.6, 7.4, 7.4), None];
-    assert!(outpredicted(&mut ev, &mut gains, &before).is_none());
+    assert!(outpredicted(&mut ev, &mut gains, &before, false).is_none());
     assert_eq!(ev[0].kind, EffectKind::GyroBias);
 }
 
