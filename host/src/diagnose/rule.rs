@@ -149,14 +149,12 @@ fn carried_behind(kind: EffectKind, gi: [f64; 2], gj: [f64; 2]) -> bool {
         && gj[1] - gi[1] >= GAIN_PP
 }
 
-/// Are `a` and `b` current and wind, which an anemometer tells apart by the true wind it
-/// measures (a current carries ship and anemometer alike and leaves none)? Held-out yaw-rate
-/// prediction does not overturn that measurement: where the yaw channel shows no
-/// heading-dependent moment, the wind's four moment harmonics fitted on the estimation part
-/// only lose on the held-out part (Mariner, a half-strength wind hidden, seed 2: the
-/// anemometer's true wind 7.26 m/s from 45°, p < 10⁻¹⁶; the wind −0.08 / −1.40 pp against the
-/// current's +0.00 / +0.08 at 10 steps / in simulation, which named `current`).
-pub(super) fn anemometer_decides(a: EffectKind, b: EffectKind) -> bool {
+/// Are `a` and `b` current and wind (in either order)? The two share speed over ground's
+/// evidence (a current carries the ship; wind's leeway moves it too, and turns it), so what
+/// tells them apart is a channel: the anemometer's true wind when the records log it (a
+/// current carries ship and anemometer alike and leaves none), else the yaw moment's heading
+/// harmonics.
+pub(super) fn current_and_wind(a: EffectKind, b: EffectKind) -> bool {
     matches!(
         (a, b),
         (EffectKind::Current, EffectKind::Wind) | (EffectKind::Wind, EffectKind::Current)
@@ -186,8 +184,12 @@ pub(super) struct Outpredicted {
 /// while the other predicts better on both; the held-out records at both horizons are the
 /// common yardstick. An effect its own channel shows (heading, speed over ground) is not
 /// displaced by one no channel shows — but for a current or wind that the other outpredicts
-/// by [`GAIN_PP`] at both horizons ([`carried_behind`]). Between current and wind an
-/// `anemometer` decides, not prediction ([`anemometer_decides`]). Applied to the first
+/// by [`GAIN_PP`] at both horizons ([`carried_behind`]). Between current and wind
+/// ([`current_and_wind`]) an `anemometer` decides, not prediction: where the yaw channel
+/// shows no heading-dependent moment the wind's four moment harmonics, fitted on the
+/// estimation part, only lose held out (Mariner, a half-strength wind hidden, seed 2: the
+/// anemometer's true wind 7.26 m/s from 45°, p < 10⁻¹⁶; the wind −0.08 / −1.40 pp against
+/// the current's +0.00 / +0.08 at 10 steps / in simulation named `current`). Applied to the first
 /// material effect (as [`super::verdict::ranked`] names it) until none outpredicts it
 /// (`before`: the held-out fits without any effect); returns the first effect passed over.
 pub(super) fn outpredicted(
@@ -204,7 +206,7 @@ pub(super) fn outpredicted(
         let better: Vec<(usize, [f64; 2])> = (i + 1..ev.len())
             // itself material, so that it is what is named
             .filter(|&j| is_material(ev, gains, j))
-            .filter(|&j| !(anemometer && anemometer_decides(ev[i].kind, ev[j].kind)))
+            .filter(|&j| !(anemometer && current_and_wind(ev[i].kind, ev[j].kind)))
             .filter_map(|j| Some((j, gains_at(&gains[j], before)?)))
             .filter(|&(_, gj)| outpredicts(gj, gi))
             .collect();
@@ -254,22 +256,14 @@ pub(super) fn outpredicted(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::diagnose::tests::evidence;
+    use crate::diagnose::tests::{evidence, held_out};
 
     #[test]
     fn a_current_is_named_behind_an_effect_that_predicts_far_better() {
         let before: Fits = [("10".to_string(), 36.0), ("sim".to_string(), 44.0)]
             .into_iter()
             .collect();
-        let held = |g10: f64, gsim: f64, own: f64| {
-            let fits: Fits = [
-                ("10".to_string(), 36.0 + g10),
-                ("sim".to_string(), 44.0 + gsim),
-            ]
-            .into_iter()
-            .collect();
-            Some((own, fits))
-        };
+        let held = |g10: f64, gsim: f64, own: f64| held_out(&before, g10, gsim, own);
         let run = |cur: (f64, f64), gear: (f64, f64)| {
             let mut ev = vec![
                 evidence(EffectKind::Current, 5e-12, 0.46, true),
@@ -328,15 +322,7 @@ mod tests {
         let before: Fits = [("10".to_string(), 85.0), ("sim".to_string(), 75.0)]
             .into_iter()
             .collect();
-        let held = |g10: f64, gsim: f64| {
-            let fits: Fits = [
-                ("10".to_string(), 85.0 + g10),
-                ("sim".to_string(), 75.0 + gsim),
-            ]
-            .into_iter()
-            .collect();
-            Some((g10, fits))
-        };
+        let held = |g10: f64, gsim: f64| held_out(&before, g10, gsim, g10);
         let run = |anemometer: bool| {
             let mut ev = vec![
                 evidence(EffectKind::Wind, 1e-17, 0.63, true),
@@ -355,8 +341,9 @@ mod tests {
                 EffectKind::Current
             )
         );
-        assert!(anemometer_decides(EffectKind::Current, EffectKind::Wind));
-        assert!(!anemometer_decides(EffectKind::Wind, EffectKind::Asymmetry));
-        assert!(!anemometer_decides(EffectKind::Wind, EffectKind::Wind));
+        assert!(current_and_wind(EffectKind::Current, EffectKind::Wind));
+        assert!(current_and_wind(EffectKind::Wind, EffectKind::Current));
+        assert!(!current_and_wind(EffectKind::Wind, EffectKind::Asymmetry));
+        assert!(!current_and_wind(EffectKind::Wind, EffectKind::Wind));
     }
 }

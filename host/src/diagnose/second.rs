@@ -6,7 +6,7 @@ use yawcast_shared::model::EffectKind;
 use super::channels::Channels;
 use super::compare::mean_fit;
 use super::evidence::{trial_stats, Set, Version};
-use super::rule::{compared_gains, outpredicts, NO_GAIN_PP};
+use super::rule::{compared_gains, current_and_wind, outpredicts, NO_GAIN_PP};
 use super::verdict::{effect_evidence, frozen_gain, rank, Evidence};
 use super::DiagnoseConfig;
 use crate::identify::model::{Effect, Model};
@@ -25,8 +25,8 @@ use crate::io::data::Record;
 /// without one. When that is current or wind and the other is significant too, the one that
 /// predicts the held-out records better at both horizons ([`outpredicts`]: the ranking rule's
 /// second clause) is named — unless the records log the anemometer, whose true wind decides
-/// between them as in the first stage ([`super::rule::anemometer_decides`]). Beside the effect, why it is named, in words (its channel, its
-/// held-out gain, or the second clause).
+/// between them as in the first stage ([`super::rule::outpredicted`]). Beside the effect, why
+/// it is named, in words (its channel, its held-out gain, or the second clause).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn second_effect(
     base: &Model,
@@ -43,14 +43,8 @@ pub(super) fn second_effect(
 ) -> Option<(Evidence, String)> {
     let k1 = first.kind();
     let with_first = &base.clone().with_effect(*first);
-    let shares_speed = |k: EffectKind| {
-        matches!(
-            (k1, k),
-            (EffectKind::Current, EffectKind::Wind) | (EffectKind::Wind, EffectKind::Current)
-        )
-    };
     let keep: Vec<usize> = (0..grids.len())
-        .filter(|&i| grids[i].0 != k1 && !shares_speed(grids[i].0))
+        .filter(|&i| grids[i].0 != k1 && !current_and_wind(k1, grids[i].0))
         .collect();
     let rest: Vec<(EffectKind, Vec<Effect>)> = keep.iter().map(|&i| grids[i].clone()).collect();
     let kept: Vec<Version> = keep.iter().map(|&i| versions[i].clone()).collect();
@@ -74,14 +68,11 @@ pub(super) fn second_effect(
     })?;
     // current or wind: the ranking rule's second clause between the two, as in the first
     // stage — the one that predicts the held-out records better at both horizons is named;
-    // an anemometer decides between them instead (`anemometer_decides`)
-    let partner = match ev[pick].kind {
-        EffectKind::Current => Some(EffectKind::Wind),
-        EffectKind::Wind => Some(EffectKind::Current),
-        _ => None,
-    }
-    .filter(|_| ch.anemometer.is_none());
-    if let Some(j) = partner.and_then(|k| ev.iter().position(|e| e.kind == k && e.p < level)) {
+    // an anemometer decides between them instead
+    let partner = ev.iter().position(|e| {
+        ch.anemometer.is_none() && current_and_wind(ev[pick].kind, e.kind) && e.p < level
+    });
+    if let Some(j) = partner {
         let held_out = |e: &Evidence| {
             let (_, fits) = frozen_gain(with_first, e, &est_set, held.1, &before, cfg.parallel);
             compared_gains(&fits, &before)

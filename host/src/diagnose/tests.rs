@@ -554,6 +554,24 @@ fn missing_heading_and_speed_are_said() {
     assert!(d.reference_used);
 }
 
+/// Held-out figures of a significant effect for the ranking rule: the fits `before` raised by
+/// `g10` at 10 steps and `gsim` in simulation (pp), and `own`, the gain on the effect's own
+/// horizon, as `frozen_gain` reports it.
+pub(super) fn held_out(
+    before: &super::rule::Fits,
+    g10: f64,
+    gsim: f64,
+    own: f64,
+) -> super::rule::HeldOut {
+    let mut fits = before.clone();
+    for (key, g) in [("10", g10), ("sim", gsim)] {
+        *fits
+            .get_mut(key)
+            .expect("a fit at 10 steps and in simulation") += g;
+    }
+    Some((own, fits))
+}
+
 pub(super) fn evidence(kind: EffectKind, p: f64, p_yaw: f64, channel_material: bool) -> Evidence {
     Evidence {
         kind,
@@ -656,17 +674,7 @@ fn an_effect_that_predicts_worse_at_both_horizons_is_named_behind() {
     let before: BTreeMap<String, f64> = [("10".to_string(), 80.0), ("sim".to_string(), 60.0)]
         .into_iter()
         .collect();
-    // held-out fits from gains (pp) at 10 steps and in simulation; `own`: the effect's own
-    // horizon's gain, as `frozen_gain` reports it
-    let held = |g10: f64, gsim: f64, own: f64| {
-        let fits: BTreeMap<String, f64> = [
-            ("10".to_string(), 80.0 + g10),
-            ("sim".to_string(), 60.0 + gsim),
-        ]
-        .into_iter()
-        .collect();
-        Some((own, fits))
-    };
+    let held = |g10: f64, gsim: f64, own: f64| held_out(&before, g10, gsim, own);
     // Mariner, asymmetry hidden (seed 3 at full strength): the steady moment has the larger
     // statistic (its 50-step horizon), the asymmetry predicts better at both horizons
     let mut ev = vec![
