@@ -142,7 +142,7 @@ print(json.load(open(sys.argv[1]))["records"][0]["fit"]["10"])'
             && "$YAWCAST" augment --model "$WORK/$world/ref.postcard" --effect auto --more \
                 "${refs[@]}" "${data[@]}" --seed "$seed" --out "$dir/more" \
                 >>"$dir/won-back.log" 2>&1; then
-            local o l r a m ok=1
+            local o l r a mo ok=1
             o=$(python3 -c 'import json,sys
 print(json.load(open(sys.argv[1]))["records"][0]["oracle_fit_pct"])' "$dir/val.json")
             for m in linear ref won more; do
@@ -155,10 +155,10 @@ print(json.load(open(sys.argv[1]))["records"][0]["oracle_fit_pct"])' "$dir/val.j
                 l=$(python3 -c "$fit10" "$dir/val-linear.json")
                 r=$(python3 -c "$fit10" "$dir/val-ref.json")
                 a=$(python3 -c "$fit10" "$dir/val-won.json")
-                m=$(python3 -c "$fit10" "$dir/val-more.json")
+                mo=$(python3 -c "$fit10" "$dir/val-more.json")
                 fits=$(python3 -c 'import sys
 o, l, r, a, m = map(float, sys.argv[1:])
-print(f"{o:.2f}/{max(l, r):.2f}/{a:.2f}/{m:.2f}")' "$o" "$l" "$r" "$a" "$m")
+print(f"{o:.2f}/{max(l, r):.2f}/{a:.2f}/{m:.2f}")' "$o" "$l" "$r" "$a" "$mo")
             fi
         fi
     fi

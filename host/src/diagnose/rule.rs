@@ -189,8 +189,8 @@ pub(super) struct Outpredicted {
 /// shows no heading-dependent moment the wind's four moment harmonics, fitted on the
 /// estimation part, only lose held out (Mariner, a half-strength wind hidden, seed 2: the
 /// anemometer's true wind 7.26 m/s from 45°, p < 10⁻¹⁶; the wind −0.08 / −1.40 pp against
-/// the current's +0.00 / +0.08 at 10 steps / in simulation named `current`). Applied to the first
-/// material effect (as [`super::verdict::ranked`] names it) until none outpredicts it
+/// the current's +0.00 / +0.08 at 10 steps / in simulation named `current`). Applied to the
+/// first material effect (as [`super::verdict::ranked`] names it) until none outpredicts it
 /// (`before`: the held-out fits without any effect); returns the first effect passed over.
 pub(super) fn outpredicted(
     ev: &mut Vec<Evidence>,

@@ -16,9 +16,9 @@ use crate::io::data::Record;
 /// What the trials show beside the verdict's effect `first`: each other effect's statistic
 /// `D` measured on the trials against the model with `first` (its trial version, θ frozen as
 /// in the first stage), from the first stage's reference versions (`versions[i]` for
-/// `grids[i]`, found against `base`: the reference lacks `first`), judged against the first stage's null replicates
-/// (`nulls[i]` for `grids[i]`: the null of an effect's statistic depends on its grid and the
-/// records, not on what else the model carries). Current and wind share speed over ground's
+/// `grids[i]`, found against `base`: the reference lacks `first`), judged against the first
+/// stage's null replicates (`nulls[i]` for `grids[i]`: the null of an effect's statistic
+/// depends on its grid and the records, not on what else the model carries). Current and wind share speed over ground's
 /// evidence, so beside either the other is not a second effect. The others are ranked by the
 /// first stage's rule ([`rank`]); the second effect is the first of them that [`named_second`]
 /// accepts, its held-out gain measured on `held` (estimation part, held-out part); `None`
