@@ -8,7 +8,9 @@
 #
 #   --yawcast PATH    the binary (default: build the ci profile and use it)
 #   --work DIR        records, models and diagnoses (default target/bench-worlds)
-#   --worlds LIST     comma-separated worlds (default lng,kvlcc2,mariner)
+#   --worlds LIST     comma-separated worlds (default lng,kvlcc2,mariner); NAME@L is the
+#                     world Froude-scaled to a length L m (`simulate --scale L`; e.g.
+#                     kvlcc2@7, the tanker at model scale, Ts 0.15 s)
 #   --seeds N         seeds per case (default 3)
 #   --strengths LIST  comma-separated effect strengths (default 1,0.5)
 #   --effects LIST    comma-separated effects (default: none and every library effect); a
@@ -65,7 +67,7 @@ while [ $# -gt 0 ]; do
         --log-wind) logwind="--log-wind"; shift ;;
         --augment) augment=1; shift ;;
         --won-back) wonback=1; shift ;;
-        -h|--help) sed -n '2,38p' "$0"; exit 0 ;;
+        -h|--help) sed -n '2,41p' "$0"; exit 0 ;;
         *) echo "unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
@@ -87,13 +89,15 @@ case_run() {
     local world="$1" effect="$2" strength="$3" seed="$4"
     local dir="$WORK/$world/$effect-$strength-$seed"
     mkdir -p "$dir"
+    local sim=(--world "${world%@*}")
+    [[ "$world" == *@* ]] && sim+=(--scale "${world#*@}")
     local eff=()
     if [ "$effect" != none ]; then
         IFS=+ read -r -a parts <<<"$effect"
         for p in "${parts[@]}"; do eff+=(--effect "$p"); done
         eff+=(--strength "$strength")
     fi
-    "$YAWCAST" simulate --world "$world" "${eff[@]}" --records 3 --seed $((100 * seed)) \
+    "$YAWCAST" simulate "${sim[@]}" "${eff[@]}" --records 3 --seed $((100 * seed)) \
         --gyro-noise 0.03 --heading-noise 0.2 --speed-noise 0.02 $LOGWIND \
         --out "$dir/trial.csv" >"$dir/simulate.log" 2>&1
     local refs=()
@@ -130,7 +134,7 @@ print("+".join(e) if e else "none")' "$dir/augment.json")
         fits="error"
         local fit10='import json,sys
 print(json.load(open(sys.argv[1]))["records"][0]["fit"]["10"])'
-        if "$YAWCAST" simulate --world "$world" "${eff[@]}" --records 1 \
+        if "$YAWCAST" simulate "${sim[@]}" "${eff[@]}" --records 1 \
             --seed $((100 * seed + 50)) --gyro-noise 0.03 --heading-noise 0.2 \
             --speed-noise 0.02 $LOGWIND --oracle-horizon 10 --out "$dir/val.csv" \
             --json "$dir/val.json" >"$dir/won-back.log" 2>&1 \
@@ -173,7 +177,9 @@ start=$(date +%s)
 for w in "${world_list[@]}"; do
     mkdir -p "$work/$w"
     if [ ! -f "$work/$w/ref.postcard" ]; then
-        "$yawcast" simulate --world "$w" --records 3 --seed 900 --gyro-noise 0.02 \
+        sim=(--world "${w%@*}")
+        [[ "$w" == *@* ]] && sim+=(--scale "${w#*@}")
+        "$yawcast" simulate "${sim[@]}" --records 3 --seed 900 --gyro-noise 0.02 \
             --heading-noise 0.1 $logwind --out "$work/$w/ref.csv" >"$work/$w/ref.log" 2>&1
         "$yawcast" identify --data "$work/$w/ref-1.csv" --data "$work/$w/ref-2.csv" \
             --data "$work/$w/ref-3.csv" --out "$work/$w/ref" >>"$work/$w/ref.log" 2>&1
@@ -203,7 +209,8 @@ def accounted(augmented):
     """The effects the model augment writes accounts for: a current in the yaw-rate model
     or in its heading/track part."""
     return {"current" if x == "track-current" else x for x in augmented.split("+")}
-worlds = sorted({r[0] for r in allrows}, key=["lng", "kvlcc2", "mariner"].index)
+order = ["lng", "kvlcc2", "mariner"]
+worlds = sorted({r[0] for r in allrows}, key=lambda w: (order.index(w) if w in order else len(order), w))
 print(f"# Cross-world diagnosis ({len(allrows)} cases, {secs} s on {cores} cores)\n")
 if pairs:
     print("## Two effects: both named by the ranked verdict (verdict, then)\n")
