@@ -78,6 +78,13 @@ fi
 mkdir -p "$work"
 export YAWCAST="$yawcast" WORK="$work" LOGWIND="$logwind" AUGMENT="$augment" WONBACK="$wonback"
 
+# a world's `simulate` arguments, one a line: NAME, or NAME@L for the world scaled to L m
+world_args() {
+    printf '%s\n' --world "${1%@*}"
+    if [[ "$1" == *@* ]]; then printf '%s\n' --scale "${1#*@}"; fi
+}
+export -f world_args
+
 # one case: world effect strength seed → a line
 # "world<TAB>strength<TAB>effect<TAB>seed<TAB>verdict<TAB>then<TAB>augmented<TAB>fits"
 # (augmented: the effects of the model `augment --effect auto --more` writes, joined by +,
@@ -89,8 +96,8 @@ case_run() {
     local world="$1" effect="$2" strength="$3" seed="$4"
     local dir="$WORK/$world/$effect-$strength-$seed"
     mkdir -p "$dir"
-    local sim=(--world "${world%@*}")
-    [[ "$world" == *@* ]] && sim+=(--scale "${world#*@}")
+    local sim=()
+    mapfile -t sim < <(world_args "$world")
     local eff=()
     if [ "$effect" != none ]; then
         IFS=+ read -r -a parts <<<"$effect"
@@ -177,8 +184,7 @@ start=$(date +%s)
 for w in "${world_list[@]}"; do
     mkdir -p "$work/$w"
     if [ ! -f "$work/$w/ref.postcard" ]; then
-        sim=(--world "${w%@*}")
-        [[ "$w" == *@* ]] && sim+=(--scale "${w#*@}")
+        mapfile -t sim < <(world_args "$w")
         "$yawcast" simulate "${sim[@]}" --records 3 --seed 900 --gyro-noise 0.02 \
             --heading-noise 0.1 $logwind --out "$work/$w/ref.csv" >"$work/$w/ref.log" 2>&1
         "$yawcast" identify --data "$work/$w/ref-1.csv" --data "$work/$w/ref-2.csv" \
