@@ -216,7 +216,8 @@ def accounted(augmented):
     or in its heading/track part."""
     return {"current" if x == "track-current" else x for x in augmented.split("+")}
 order = ["lng", "kvlcc2", "mariner"]
-worlds = sorted({r[0] for r in allrows}, key=lambda w: (order.index(w) if w in order else len(order), w))
+worlds = sorted({r[0] for r in allrows},
+                key=lambda w: (order.index(w) if w in order else len(order), w))
 print(f"# Cross-world diagnosis ({len(allrows)} cases, {secs} s on {cores} cores)\n")
 if pairs:
     print("## Two effects: both named by the ranked verdict (verdict, then)\n")

@@ -18,11 +18,11 @@ use crate::io::data::Record;
 /// in the first stage), from the first stage's reference versions (`versions[i]` for
 /// `grids[i]`, found against `base`: the reference lacks `first`), judged against the first
 /// stage's null replicates (`nulls[i]` for `grids[i]`: the null of an effect's statistic
-/// depends on its grid and the records, not on what else the model carries). Current and wind share speed over ground's
-/// evidence, so beside either the other is not a second effect. The others are ranked by the
-/// first stage's rule ([`rank`]); the second effect is the first of them that [`named_second`]
-/// accepts, its held-out gain measured on `held` (estimation part, held-out part); `None`
-/// without one. When that is current or wind and the other is significant too, the one that
+/// depends on its grid and the records, not on what else the model carries). Current and
+/// wind share speed over ground's evidence, so beside either the other is not a second
+/// effect. The others are ranked by the first stage's rule ([`rank`]); the second effect is
+/// the first of them that [`named_second`] accepts, its held-out gain measured on `held`
+/// (estimation part, held-out part); `None` without one. When that is current or wind and the other is significant too, the one that
 /// predicts the held-out records better at both horizons ([`outpredicts`]: the ranking rule's
 /// second clause) is named — unless the records log the anemometer, whose true wind decides
 /// between them as in the first stage ([`super::rule::outpredicted`]). Beside the effect, why
