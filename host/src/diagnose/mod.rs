@@ -20,16 +20,24 @@
 //!   2 s dead time on a ship whose own gear turns at 4 °/s looked like a gear of
 //!   5 °/s, and trials with no hidden effect showed a slow gear. So first the reference's
 //!   own gear dynamics are looked for with θ re-identified ([`crate::diagnose::augment::forward`] over
-//!   the gear dynamics effects on the reference records, its rule for keeping an effect);
+//!   the gear dynamics effects on the reference records, its rule for keeping an effect,
+//!   judged against the structure re-identified on the same part: the reference model saw the
+//!   held-out third, so its fit there is in-sample and no yardstick);
 //!   when the reference shows some, every statistic below is measured against the reference
 //!   model with it (`base`), and a trial's departure from the reference's gear is tested as
 //!   that effect's parameter moving. Angle limits are left to the frozen reference version:
 //!   static, they cannot hide in the poles.
 //! - **Null distribution by parametric bootstrap.** The innovations model (with the
 //!   reference's own gear, when it shows one) is simulated with the reference's innovation
-//!   variance on the reference and trial inputs; `D` is recomputed on each replicate and a scaled χ² is fitted to the
-//!   replicates (Satterthwaite), which gives the p-value. No threshold is set by hand: an
-//!   effect is *significant* at level α.
+//!   variance on the reference and trial inputs; `D` is recomputed on each replicate and a
+//!   scaled χ² is fitted to the replicates (Satterthwaite), which gives the p-value. No
+//!   threshold is set by hand: an effect is *significant* at level α.
+//! - **The reference's own spread.** For an effect with no free gain (dead time, gear rate,
+//!   angle limit, dead band) data from the linear model can only fit worse, so the
+//!   bootstrap's replicates are (almost) all 0 and say nothing of how far two effect-free
+//!   sets of a nonlinear hull differ. Each part of the reference (a record, or a piece of
+//!   one) is therefore also measured as a trial against the others, `D` scaled to the
+//!   trials; p is the larger of the two nulls' (`null::with_spread`).
 //! - **Every channel.** Heading separates a gyro bias from a yaw moment: over a record,
 //!   `mean(r) − mean(dψ/dt)` equals the rate-sensor offset and is ≈ 0 for a true moment.
 //!   Speed over ground modulated with heading (harmonics in ψ) reveals current and wind,
@@ -376,7 +384,7 @@ pub fn diagnose(
     let real = trial_stats(base, est, &grids, &versions, cfg.parallel);
     bar.inc(1);
     bar.set_message("bootstrap replicates");
-    let nulls = bootstrap(
+    let boot = bootstrap(
         base,
         reference,
         est,
@@ -387,6 +395,7 @@ pub fn diagnose(
         cfg.seed,
         cfg.parallel,
     );
+    let nulls = null::with_spread(boot, base, reference, &grids, &real, cfg.parallel);
     bar.set_message("encompassing test, materiality");
     let evidence: Vec<Evidence> = kinds
         .iter()

@@ -1,5 +1,6 @@
-//! The parametric-bootstrap nulls: the innovations model simulated on the recorded
-//! commands, `D` recomputed on each replicate, and the scaled χ² fitted to the replicates.
+//! The nulls: the parametric bootstrap (the innovations model simulated on the recorded
+//! commands, `D` recomputed on each replicate, a scaled χ² fitted to the replicates) and,
+//! for the effects with no free gain, the reference's own spread of `D` between its parts.
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -120,4 +121,204 @@ pub(super) fn bootstrap(
     (0..grids.len())
         .map(|k| per.iter().map(|v| v[k]).collect())
         .collect()
+}
+
+/// Parts of the reference records, at least three: the records themselves, or each record
+/// cut into equal pieces when there are fewer than three; empty when a piece would be
+/// shorter than `min_len` samples.
+pub(super) fn reference_parts(reference: &[Record], min_len: usize) -> Vec<Record> {
+    if reference.len() >= 3 {
+        return reference.to_vec();
+    }
+    let k = 3usize.div_ceil(reference.len().max(1));
+    let mut parts = Vec::new();
+    for r in reference {
+        let len = r.len() / k;
+        if len < min_len {
+            return Vec::new();
+        }
+        for i in 0..k {
+            let mut p = r.slice(i * len, if i + 1 == k { r.len() } else { (i + 1) * len });
+            p.name = format!("{} (part {} of {k})", r.name, i + 1);
+            parts.push(p);
+        }
+    }
+    parts
+}
+
+/// The replicates one effect's statistic is judged against: the bootstrap's, and for an
+/// effect with no free gain the reference's own spread ([`with_spread`]).
+#[derive(Debug, Clone)]
+pub(super) struct Nulls {
+    /// Bootstrap replicates of `D`.
+    pub(super) boot: Vec<f64>,
+    /// `D` of each part of the reference measured against the others, scaled to the trials.
+    pub(super) spread: Option<Vec<f64>>,
+}
+
+impl Nulls {
+    /// The null `d` is judged against: the bootstrap's, or the reference's own spread where
+    /// that gives the larger p-value (the more conservative of the two); with the largest
+    /// `D` of the spread when it is the spread's.
+    pub(super) fn at(&self, d: f64) -> (Null, Option<f64>) {
+        let boot = Null::fit(&self.boot);
+        match &self.spread {
+            Some(s) => {
+                let spread = Null::fit(s);
+                if spread.p(d) > boot.p(d) {
+                    (spread, Some(s.iter().copied().fold(0.0, f64::max)))
+                } else {
+                    (boot, None)
+                }
+            }
+            None => (boot, None),
+        }
+    }
+}
+
+/// The nulls of every kind of `grids` (`boot[i]`, the bootstrap replicates of `grids[i]`),
+/// with the reference's own spread for the effects with no free gain (dead time, gear rate,
+/// angle limit, dead band: their structure is searched on a grid, nothing fitted).
+///
+/// Why: data simulated from the linear model never favour such an effect — it can only
+/// worsen a linear model's fit — so their bootstrap replicates are (almost) all 0 and say
+/// nothing about how large `D` gets without the effect, and any `D` > 0 would read as
+/// significant. Yet a linear model meets a nonlinear hull differently on different inputs:
+/// on the built-in ship, one reference record against the other two shows an angle limit
+/// just under the largest command (a few per cent less gain) at D ≈ 29 scaled to the
+/// trials, and effect-free trials show the same. So each part of the reference (a record,
+/// or a piece of one when there are fewer than three: [`reference_parts`]) is measured as a
+/// trial against the version the other parts show, `D` scaled to the trials' error count
+/// (`real[i].n`), and p is the larger of the two nulls'. `trial` stays as it is when the
+/// reference is empty or too short to cut.
+pub(super) fn with_spread(
+    boot: Vec<Vec<f64>>,
+    model: &Model,
+    reference: &[Record],
+    grids: &[(EffectKind, Vec<Effect>)],
+    real: &[super::evidence::WorldStat],
+    parallel: bool,
+) -> Vec<Nulls> {
+    let gainless: Vec<usize> = (0..grids.len())
+        .filter(|&i| crate::effects::def(grids[i].0).gains.is_empty())
+        .collect();
+    let parts = reference_parts(reference, super::MIN_SAMPLES);
+    let mut spread: Vec<Option<Vec<f64>>> = vec![None; grids.len()];
+    if parts.len() >= 3 && !gainless.is_empty() {
+        let sub: Vec<(EffectKind, Vec<Effect>)> =
+            gainless.iter().map(|&i| grids[i].clone()).collect();
+        let per: Vec<Vec<f64>> = crate::par::map_range(parts.len(), parallel, |j| {
+            let others: Vec<Record> = parts
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| *i != j)
+                .map(|(_, p)| p.clone())
+                .collect();
+            let versions = super::evidence::reference_versions(model, &others, &sub, false);
+            let part = std::slice::from_ref(&parts[j]);
+            super::evidence::trial_stats(model, part, &sub, &versions, false)
+                .into_iter()
+                .zip(&gainless)
+                .map(|(w, &i)| w.d * real[i].n as f64 / w.n.max(1) as f64)
+                .collect()
+        });
+        for (k, &i) in gainless.iter().enumerate() {
+            spread[i] = Some(per.iter().map(|v| v[k]).collect());
+        }
+    }
+    boot.into_iter()
+        .zip(spread)
+        .map(|(boot, spread)| Nulls { boot, spread })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_reference_is_cut_into_three_parts_at_least() {
+        let rec = |n: usize| Record::from_uy("r", 1.0, vec![0.0; n], vec![0.0; n]);
+        // three records or more: the records themselves
+        let p = reference_parts(&[rec(500), rec(600), rec(700)], 100);
+        assert_eq!(
+            p.iter().map(Record::len).collect::<Vec<_>>(),
+            [500, 600, 700]
+        );
+        // one record: three pieces, the last taking the remainder
+        let p = reference_parts(&[rec(1801)], 100);
+        assert_eq!(
+            p.iter().map(Record::len).collect::<Vec<_>>(),
+            [600, 600, 601]
+        );
+        assert_eq!(p[2].name, "r (part 3 of 3)");
+        // two records: two pieces each
+        let p = reference_parts(&[rec(400), rec(300)], 100);
+        assert_eq!(
+            p.iter().map(Record::len).collect::<Vec<_>>(),
+            [200, 200, 150, 150]
+        );
+        // pieces too short: none
+        assert!(reference_parts(&[rec(250)], 100).is_empty());
+        assert!(reference_parts(&[], 100).is_empty());
+    }
+
+    #[test]
+    fn a_degenerate_bootstrap_yields_to_the_references_spread() {
+        // the built-in ship's angle limit on effect-free trials: every bootstrap replicate 0
+        // (a clip only worsens data from the linear model), one reference record against
+        // the other two 28.6, the trials 42.6
+        let n = Nulls {
+            boot: vec![0.0; 24],
+            spread: Some(vec![0.0, 28.6, 0.0]),
+        };
+        let level = 0.01 / 9.0;
+        let (alone, _) = Nulls {
+            spread: None,
+            ..n.clone()
+        }
+        .at(42.6);
+        assert!(alone.p(42.6) < 1e-12, "{}", alone.p(42.6));
+        let (null, max) = n.at(42.6);
+        assert_eq!(max, Some(28.6));
+        let p = null.p(42.6);
+        assert!(p > level && p < 0.2, "{p}");
+        // a real angle limit (half strength: D of several hundred) stays significant
+        let (null, _) = n.at(253.5);
+        assert!(null.p(253.5) < 1e-4, "{}", null.p(253.5));
+        // where the bootstrap has the larger p it governs
+        let wide = Nulls {
+            boot: (0..24).map(|i| 30.0 * f64::from(i) / 23.0).collect(),
+            spread: Some(vec![0.0, 1.0, 0.5]),
+        };
+        assert_eq!(wide.at(20.0).1, None);
+    }
+
+    #[test]
+    fn an_angle_limit_within_the_references_own_spread_is_no_effect() {
+        // the acceptance suite's effect-free case 43 on its reference 1, whose own gear
+        // (a slew limit) the statistics are measured against: the trials show an angle
+        // limit just under the largest command at D ≈ 43, where every bootstrap replicate
+        // is 0 and one reference record against the other two gives D ≈ 29
+        use crate::diagnose::tests::{identify, records};
+        use crate::diagnose::{diagnose, DiagnoseConfig};
+        let reference = records(None, &[903, 904, 905]);
+        let model = identify(&reference);
+        let est = records(None, &[430, 431, 432]);
+        let cfg = DiagnoseConfig {
+            seed: 43,
+            ..DiagnoseConfig::default()
+        };
+        let d = diagnose(&model, &reference, &est, &[], &cfg).unwrap();
+        let sat = d.ranking.iter().find(|r| r.effect == "saturation").unwrap();
+        assert_eq!(d.verdict, "none", "{}", d.explanation);
+        assert!(d.reference_gear.is_some());
+        assert!(sat.statistic > 20.0 && !sat.significant, "{sat:?}");
+        assert!(sat.p_value > 0.01 / 9.0, "{sat:?}");
+        assert!(
+            sat.evidence.contains("the reference's own spread"),
+            "{}",
+            sat.evidence
+        );
+    }
 }

@@ -6,6 +6,7 @@ use yawcast_shared::model::EffectKind;
 use super::channels::Channels;
 use super::compare::mean_fit;
 use super::evidence::{trial_stats, Set, Version};
+use super::null::Nulls;
 use super::rule::{compared_gains, current_and_wind, outpredicts, NO_GAIN_PP};
 use super::verdict::{effect_evidence, frozen_gain, rank, Evidence};
 use super::DiagnoseConfig;
@@ -34,7 +35,7 @@ pub(super) fn second_effect(
     versions: &[Version],
     est: &[Record],
     grids: &[(EffectKind, Vec<Effect>)],
-    nulls: &[Vec<f64>],
+    nulls: &[Nulls],
     level: f64,
     has_ref: bool,
     cfg: &DiagnoseConfig,

@@ -12,7 +12,7 @@ use super::augment::AugmentReport;
 use super::channels::{add_channels, Channels};
 use super::compare::mean_fit;
 use super::evidence::{effect_with, horizon_of, Quad, Set, WorldStat};
-use super::null::Null;
+use super::null::{Null, Nulls};
 use super::rule::{gain_at, gains_at, Fits, GAIN_PP, NO_GAIN_PP};
 use super::{DiagnoseConfig, Ranked, SLOW_HORIZON, WINDOW, WINDOW_BLOCK};
 use crate::identify::model::{Effect, Model};
@@ -56,7 +56,7 @@ pub(super) fn effect_evidence(
     model: &Model,
     kind: EffectKind,
     stat: &WorldStat,
-    null_reps: &[f64],
+    nulls: &Nulls,
     has_ref: bool,
     cfg: &DiagnoseConfig,
     ch: &Channels,
@@ -66,7 +66,7 @@ pub(super) fn effect_evidence(
     let d = stat.d;
     let tn = stat.n;
     let best = stat.best;
-    let null = Null::fit(null_reps);
+    let (null, spread_max) = nulls.at(d);
     let p_yaw = null.p(d);
     let mut ev = Evidence {
         kind,
@@ -86,6 +86,13 @@ pub(super) fn effect_evidence(
     };
     let pct = 100.0 * (1.0 - (-d / tn.max(1) as f64).exp());
     yaw_words(&mut ev, ts, pct);
+    if let Some(m) = spread_max.filter(|_| d > 0.0) {
+        ev.words.push_str(&format!(
+            " (p against the reference's own spread, wider than the bootstrap's: each part of \
+             the reference measured against the others gives D up to {m:.0}, scaled to the trials, \
+             against {d:.0} here)"
+        ));
+    }
     add_channels(&mut ev, has_ref, cfg, ch);
     ev
 }

@@ -380,12 +380,14 @@ pub(super) struct Judgement {
 
 /// Step 4's rule for a candidate identified on the estimation records and evaluated on
 /// the held-out ones (`after`): ΔAIC and ΔBIC against the baseline, the paired held-out
-/// gains, and the reasons not to keep it.
+/// gains, and the reasons not to keep it. `before` is the input model's evaluation, the
+/// yardstick of [`Reason::WorseThanInput`]; `None` when the input model's held-out fit is
+/// in-sample ([`AugmentConfig::input_in_sample`]).
 pub(super) fn judge(
     kind: EffectKind,
     cand: &PemReport,
     base: &PemReport,
-    before: &Eval,
+    before: Option<&Eval>,
     baseline: &Eval,
     after: &Eval,
 ) -> Judgement {
@@ -436,12 +438,13 @@ pub(super) fn judge(
     if worse {
         reasons.push(Reason::SignificantlyWorse(gains));
     }
-    for k in ["10", "sim"] {
-        if worse_fit(get(after, k), get(before, k)) {
+    for k in ["10", "sim"].into_iter().filter(|_| before.is_some()) {
+        let before = before.map_or(f64::NAN, |b| get(b, k));
+        if worse_fit(get(after, k), before) {
             reasons.push(Reason::WorseThanInput {
                 horizon: k.to_string(),
                 after: get(after, k),
-                before: get(before, k),
+                before,
             });
         }
     }

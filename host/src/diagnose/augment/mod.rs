@@ -110,6 +110,11 @@ pub struct AugmentConfig {
     pub horizons: Vec<Horizon>,
     /// Evaluate grid points and records in parallel (rayon).
     pub parallel: bool,
+    /// The input model was identified on the whole estimation records, the held-out part
+    /// included, so its held-out fit is in-sample: it is then no yardstick, and a candidate
+    /// is judged against the input structure re-identified on the estimation part alone
+    /// (the reason "validates worse than the input model" is not applied). Default false.
+    pub input_in_sample: bool,
 }
 
 impl Default for AugmentConfig {
@@ -118,6 +123,7 @@ impl Default for AugmentConfig {
             pem: PemConfig::default(),
             horizons: Horizon::REPORT.to_vec(),
             parallel: true,
+            input_in_sample: false,
         }
     }
 }
@@ -369,7 +375,8 @@ fn try_effect(
     };
     let after = evaluate(&cand.model, val_part, horizons, cfg.parallel);
 
-    let mut j = judge(kind, &cand, base, before, baseline, &after);
+    let yardstick = (!cfg.input_in_sample).then_some(before);
+    let mut j = judge(kind, &cand, base, yardstick, baseline, &after);
     let get = |e: &Eval, k: &str| e.mean.get(k).copied().unwrap_or(f64::NAN);
 
     // the candidate finally returned: re-fitted on the whole records when a part was held out
