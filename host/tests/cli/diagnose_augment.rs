@@ -77,11 +77,21 @@ fn diagnose_names_a_hidden_dead_time_and_writes_stable_json() {
     assert_eq!(v["seed"], 5);
     assert_eq!(v["reference_used"], true);
     // references given, heading and speed logged, short records: nothing qualifies it but
-    // the smallest current speed over ground would show (a few cm/s on this ship's records)
+    // the reference's own gear (the built-in ship's slews at 20 °/s) and the smallest
+    // current speed over ground would show (a few cm/s on this ship's records)
     let caveats = v["caveats"].as_array().unwrap();
-    assert_eq!(caveats.len(), 1, "{}", v["explanation"]);
-    assert_eq!(caveats[0]["caveat"], "current-resolution");
-    let smallest = caveats[0]["smallest_mps"].as_f64().unwrap();
+    assert_eq!(caveats.len(), 2, "{}", v["explanation"]);
+    assert_eq!(caveats[0]["caveat"], "reference-gear");
+    let gear = caveats[0]["words"].as_str().unwrap();
+    let rate: f64 = gear
+        .split("a slew limit of ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("{gear}"));
+    assert!((15.0..25.0).contains(&rate), "{gear}");
+    assert_eq!(caveats[1]["caveat"], "current-resolution");
+    let smallest = caveats[1]["smallest_mps"].as_f64().unwrap();
     assert!(smallest > 0.001 && smallest < 0.1, "{smallest}");
     assert_eq!(v["ranking"][0]["effect"], "dead-time");
     assert!(v["ranking"][0]["p_value"].as_f64().unwrap() < 1e-3);
