@@ -189,8 +189,8 @@ impl Nulls {
 /// trials, and effect-free trials show the same. So each part of the reference (a record,
 /// or a piece of one when there are fewer than three: [`reference_parts`]) is measured as a
 /// trial against the version the other parts show, `D` scaled to the trials' error count
-/// (`real[i].n`), and p is the larger of the two nulls'. `trial` stays as it is when the
-/// reference is empty or too short to cut.
+/// (`real[i].n`), and p is the larger of the two nulls'. Where the reference is empty or too
+/// short to cut into three parts of `MIN_SAMPLES`, the bootstrap's null stands alone.
 pub(super) fn with_spread(
     boot: Vec<Vec<f64>>,
     model: &Model,
