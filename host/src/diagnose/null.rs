@@ -123,12 +123,23 @@ pub(super) fn bootstrap(
         .collect()
 }
 
-/// Parts of the reference records, at least three: the records themselves, or each record
+/// Most parts the reference is cut into ([`reference_parts`]): each part is measured against
+/// all the others, so the cost grows with the square of their number; as many as the blocks
+/// of a long set ([`super::WINDOW`] / [`super::WINDOW_BLOCK`]).
+const MAX_PARTS: usize = super::WINDOW / super::WINDOW_BLOCK;
+
+/// Parts of the reference records, at least three and at most [`MAX_PARTS`]: the records
+/// themselves (dealt in turn into [`MAX_PARTS`] groups when there are more), or each record
 /// cut into equal pieces when there are fewer than three; empty when a piece would be
 /// shorter than `min_len` samples.
-pub(super) fn reference_parts(reference: &[Record], min_len: usize) -> Vec<Record> {
+pub(super) fn reference_parts(reference: &[Record], min_len: usize) -> Vec<Vec<Record>> {
     if reference.len() >= 3 {
-        return reference.to_vec();
+        let k = reference.len().min(MAX_PARTS);
+        let mut parts = vec![Vec::new(); k];
+        for (i, r) in reference.iter().enumerate() {
+            parts[i % k].push(r.clone());
+        }
+        return parts;
     }
     let k = 3usize.div_ceil(reference.len().max(1));
     let mut parts = Vec::new();
@@ -140,7 +151,7 @@ pub(super) fn reference_parts(reference: &[Record], min_len: usize) -> Vec<Recor
         for i in 0..k {
             let mut p = r.slice(i * len, if i + 1 == k { r.len() } else { (i + 1) * len });
             p.name = format!("{} (part {} of {k})", r.name, i + 1);
-            parts.push(p);
+            parts.push(vec![p]);
         }
     }
     parts
@@ -186,11 +197,12 @@ impl Nulls {
 /// significant. Yet a linear model meets a nonlinear hull differently on different inputs:
 /// on the built-in ship, one reference record against the other two shows an angle limit
 /// just under the largest command (a few per cent less gain) at D ≈ 29 scaled to the
-/// trials, and effect-free trials show the same. So each part of the reference (a record,
-/// or a piece of one when there are fewer than three: [`reference_parts`]) is measured as a
-/// trial against the version the other parts show, `D` scaled to the trials' error count
-/// (`real[i].n`), and p is the larger of the two nulls'. Where the reference is empty or too
-/// short to cut into three parts of `MIN_SAMPLES`, the bootstrap's null stands alone.
+/// trials, and effect-free trials show the same. So each part of the reference (a record or
+/// a group of them, or a piece of one when there are fewer than three: [`reference_parts`])
+/// is measured as a trial against the version the other parts show, `D` scaled to the
+/// trials' error count (`real[i].n`), and p is the larger of the two nulls'. Where the
+/// reference is empty or too short to cut into three parts of `MIN_SAMPLES`, the bootstrap's
+/// null stands alone.
 pub(super) fn with_spread(
     boot: Vec<Vec<f64>>,
     model: &Model,
@@ -212,11 +224,10 @@ pub(super) fn with_spread(
                 .iter()
                 .enumerate()
                 .filter(|(i, _)| *i != j)
-                .map(|(_, p)| p.clone())
+                .flat_map(|(_, p)| p.iter().cloned())
                 .collect();
             let versions = super::evidence::reference_versions(model, &others, &sub, false);
-            let part = std::slice::from_ref(&parts[j]);
-            super::evidence::trial_stats(model, part, &sub, &versions, false)
+            super::evidence::trial_stats(model, &parts[j], &sub, &versions, false)
                 .into_iter()
                 .zip(&gainless)
                 .map(|(w, &i)| w.d * real[i].n as f64 / w.n.max(1) as f64)
@@ -239,25 +250,28 @@ mod tests {
     #[test]
     fn the_reference_is_cut_into_three_parts_at_least() {
         let rec = |n: usize| Record::from_uy("r", 1.0, vec![0.0; n], vec![0.0; n]);
+        let lens = |p: &[Vec<Record>]| -> Vec<Vec<usize>> {
+            p.iter()
+                .map(|g| g.iter().map(Record::len).collect())
+                .collect()
+        };
         // three records or more: the records themselves
         let p = reference_parts(&[rec(500), rec(600), rec(700)], 100);
-        assert_eq!(
-            p.iter().map(Record::len).collect::<Vec<_>>(),
-            [500, 600, 700]
-        );
+        assert_eq!(lens(&p), [[500], [600], [700]]);
+        // more records than parts: dealt in turn into MAX_PARTS groups
+        let many: Vec<Record> = (0..8).map(|i| rec(200 + i)).collect();
+        let p = reference_parts(&many, 100);
+        assert_eq!(MAX_PARTS, 6);
+        assert_eq!(lens(&p)[0], [200, 206]);
+        assert_eq!(lens(&p)[1], [201, 207]);
+        assert_eq!(lens(&p)[5], [205]);
         // one record: three pieces, the last taking the remainder
         let p = reference_parts(&[rec(1801)], 100);
-        assert_eq!(
-            p.iter().map(Record::len).collect::<Vec<_>>(),
-            [600, 600, 601]
-        );
-        assert_eq!(p[2].name, "r (part 3 of 3)");
+        assert_eq!(lens(&p), [[600], [600], [601]]);
+        assert_eq!(p[2][0].name, "r (part 3 of 3)");
         // two records: two pieces each
         let p = reference_parts(&[rec(400), rec(300)], 100);
-        assert_eq!(
-            p.iter().map(Record::len).collect::<Vec<_>>(),
-            [200, 200, 150, 150]
-        );
+        assert_eq!(lens(&p), [[200], [200], [150], [150]]);
         // pieces too short: none
         assert!(reference_parts(&[rec(250)], 100).is_empty());
         assert!(reference_parts(&[], 100).is_empty());
