@@ -226,8 +226,7 @@ pub(super) fn with_spread(
                 .filter(|(i, _)| *i != j)
                 .flat_map(|(_, p)| p.iter().cloned())
                 .collect();
-            let versions = super::evidence::reference_versions(model, &others, &sub, false);
-            super::evidence::trial_stats(model, &parts[j], &sub, &versions, false)
+            world(model, &others, &parts[j], &sub, false)
                 .into_iter()
                 .zip(&gainless)
                 .map(|(w, &i)| w.d * real[i].n as f64 / w.n.max(1) as f64)

@@ -438,14 +438,16 @@ pub(super) fn judge(
     if worse {
         reasons.push(Reason::SignificantlyWorse(gains));
     }
-    for k in ["10", "sim"].into_iter().filter(|_| before.is_some()) {
-        let before = before.map_or(f64::NAN, |b| get(b, k));
-        if worse_fit(get(after, k), before) {
-            reasons.push(Reason::WorseThanInput {
-                horizon: k.to_string(),
-                after: get(after, k),
-                before,
-            });
+    // no yardstick when the input model's held-out fit is in-sample
+    if let Some(b) = before {
+        for k in ["10", "sim"] {
+            if worse_fit(get(after, k), get(b, k)) {
+                reasons.push(Reason::WorseThanInput {
+                    horizon: k.to_string(),
+                    after: get(after, k),
+                    before: get(b, k),
+                });
+            }
         }
     }
     let kept = reasons.is_empty();
