@@ -21,8 +21,8 @@
 //!   5 °/s, and trials with no hidden effect showed a slow gear. So first the reference's
 //!   own gear dynamics are looked for with θ re-identified ([`crate::diagnose::augment::forward`] over
 //!   the gear dynamics effects on the reference records, its rule for keeping an effect,
-//!   judged against the structure re-identified on the same part: the reference model saw the
-//!   held-out third, so its fit there is in-sample and no yardstick);
+//!   judged against the structure re-identified on the same part: the reference model saw
+//!   the held-out third, so its fit there is in-sample and no yardstick);
 //!   when the reference shows some, every statistic below is measured against the reference
 //!   model with it (`base`), and a trial's departure from the reference's gear is tested as
 //!   that effect's parameter moving. Angle limits are left to the frozen reference version:

@@ -70,9 +70,9 @@ pub(super) fn reference_actuator(
     let words = format!(
         " The reference records show steering-gear physics of their own that the linear \
          model has absorbed into its poles: {} (re-identified on the reference, held-out \
-         10-step fit there {:.1} % without it, {:.1} % with it). A gear the model only approximates looks like \
-         whatever actuator effect mimics it best on each record's commands, so every \
-         statistic is measured against the reference model with it.",
+         10-step fit there {:.1} % without it, {:.1} % with it). A gear the model only \
+         approximates looks like whatever actuator effect mimics it best on each record's \
+         commands, so every statistic is measured against the reference model with it.",
         own.join(" and "),
         without,
         with,
