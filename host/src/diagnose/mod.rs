@@ -525,6 +525,12 @@ pub fn diagnose(
         ));
     }
     let then = then.map(|(e, _)| e.kind.name().to_string());
+    let named = [verdict_name.as_str(), then.as_deref().unwrap_or("")];
+    caveats.extend(verdict::current_or_leeway(
+        &ev,
+        &named,
+        ch.anemometer.is_some(),
+    ));
     for c in &caveats {
         explanation.push(' ');
         explanation.push_str(&c.explain());

@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use super::channels::{sog_evidence, sog_evidence_with, sog_taus};
 use super::evidence::{trial_statistic, Version};
 use super::null::{simulate_innovations, Null};
-use super::verdict::current_or_wind;
+use super::verdict::{current_or_leeway, current_or_wind};
 use super::*;
 use crate::identify::pem::{self, PemConfig};
 use crate::sim::{simulate, NoiseSpec, Scenario, Ship, SimEffect};
@@ -788,6 +788,7 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
     assert!((ev[0].p - 8e-4).abs() < 1e-15, "{}", ev[0].p);
     assert!(ev[0].channel_material);
     assert!(ev[0].words.contains("present"), "{}", ev[0].words);
+    assert!(current_or_leeway(&ev, &["wind", "current"], false).is_none());
     // the same speed evidence without a yaw moment: a current, wind moved behind it
     let mut ev = vec![
         evidence(EffectKind::Wind, 1e-6, 0.3, true),
@@ -796,6 +797,16 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
     current_or_wind(&mut ev, level, alpha, true, None);
     assert_eq!(kinds(&ev), [EffectKind::Current, EffectKind::Wind]);
     assert_eq!(ev[1].p, 1e-6);
+    // named from the ground track alone, without an anemometer: a caveat says a wind's
+    // leeway would look the same, with the p applied (2 × 0.05); none with an anemometer,
+    // none when no current is named
+    let c = current_or_leeway(&ev, &["current", ""], false).unwrap();
+    assert_eq!(c, Caveat::CurrentOrLeeway { p_moment: 0.1 });
+    let json = serde_json::to_value(&c).unwrap();
+    assert_eq!(json["caveat"], "current-or-leeway");
+    assert!(c.explain().contains("p = 1.0e-1"), "{}", c.explain());
+    assert!(current_or_leeway(&ev, &["current", ""], true).is_none());
+    assert!(current_or_leeway(&ev, &["dead-time", ""], false).is_none());
     // without speed over ground, or with neither significant, nothing changes
     for (speed, p) in [(false, 1e-7), (true, 0.5)] {
         let mut ev = vec![

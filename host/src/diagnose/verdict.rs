@@ -165,7 +165,7 @@ pub(super) fn current_or_wind(
     if !speed || (ev[ic].p >= level && ev[iw].p >= level) {
         return;
     }
-    let p_moment = (2.0 * ev[ic].p_yaw.min(ev[iw].p_yaw)).min(1.0);
+    let p_moment = moment_p(&ev[ic], &ev[iw]);
     // an anemometer measures the wind itself: it decides, the yaw moment does not
     let (p_decide, wind) = match anemometer {
         Some(p) => (p, p < alpha),
@@ -180,7 +180,8 @@ pub(super) fn current_or_wind(
         None => (
             "yaw moment varying with heading",
             "the ship is turned by it, wind (a current carries the ship without turning it)",
-            "speed over ground alone depends on heading, the water carries the ship: a current",
+            "speed over ground alone depends on heading: the ship is set over ground without \
+             being turned, a current",
         ),
     };
     let words = format!(
@@ -507,6 +508,13 @@ pub enum Caveat {
         /// direction.
         smallest_mps: f64,
     },
+    /// A current named from speed over ground alone, with no anemometer: the wind's leeway
+    /// sets the ship over ground as a current does, and the yaw channel shows no
+    /// heading-dependent moment that would tell the wind ([`current_or_leeway`]).
+    CurrentOrLeeway {
+        /// p-value of the yaw channel's heading-dependent moment (absent: ≥ α).
+        p_moment: f64,
+    },
     /// A significant effect that does not improve held-out prediction was named behind
     /// the verdict by the ranking rule.
     PassedOver {
@@ -572,6 +580,14 @@ impl Caveat {
                 "Speed over ground on these records shows a current only from about \
                  {smallest_mps:.2} m/s on (in any direction, at the level applied: the headings \
                  sailed and the speed lost in turns limit it); a weaker current cannot be told."
+            ),
+            Caveat::CurrentOrLeeway { p_moment } => format!(
+                "The current is seen on the ground track alone and no anemometer is logged: \
+                 the wind's leeway sets a ship over ground as a current does, and the yaw \
+                 channel shows no heading-dependent moment (p {}) that would tell a wind. The \
+                 records cannot tell a current from the leeway of a wind too weak to turn the \
+                 ship; the anemometer's columns (apparent wind speed and angle) would.",
+                fmt_p(*p_moment)
             ),
             Caveat::PassedOver { effect } => {
                 let kind = EffectKind::from_name(effect);
@@ -639,6 +655,31 @@ pub(super) fn caveats(
         out.push(Caveat::NoSpeedOverGround);
     }
     out
+}
+
+/// The caveat for a current named from the ground track alone ([`Caveat::CurrentOrLeeway`]):
+/// `named` (the verdict, then its second effect) holds a current, no anemometer decided
+/// between current and wind ([`current_or_wind`]), and the yaw channel's heading-dependent
+/// moment was absent; its p-value is the one that test applied.
+pub(super) fn current_or_leeway(
+    ev: &[Evidence],
+    named: &[&str],
+    anemometer: bool,
+) -> Option<Caveat> {
+    let cur = ev.iter().find(|e| e.kind == EffectKind::Current)?;
+    if anemometer || !cur.speed_only || !named.contains(&EffectKind::Current.name()) {
+        return None;
+    }
+    let wind = ev.iter().find(|e| e.kind == EffectKind::Wind)?;
+    Some(Caveat::CurrentOrLeeway {
+        p_moment: moment_p(cur, wind),
+    })
+}
+
+/// The yaw channel's heading-dependent moment: the better of current's and wind's yaw
+/// p-values, Bonferroni over the two.
+fn moment_p(current: &Evidence, wind: &Evidence) -> f64 {
+    (2.0 * current.p_yaw.min(wind.p_yaw)).min(1.0)
 }
 
 /// Hold-out split: the last 30 % of each record (kept long enough for the slow horizon).
