@@ -524,13 +524,11 @@ pub fn diagnose(
             verdict::fmt_p(e.p)
         ));
     }
-    let then = then.map(|(e, _)| e.kind.name().to_string());
-    let named = [verdict_name.as_str(), then.as_deref().unwrap_or("")];
+    let verdict_ev = ev.iter().find(|e| e.kind.name() == verdict_name);
     caveats.extend(verdict::current_or_leeway(
-        &ev,
-        &named,
-        ch.anemometer.is_some(),
+        verdict_ev.into_iter().chain(then.as_ref().map(|(e, _)| e)),
     ));
+    let then = then.map(|(e, _)| e.kind.name().to_string());
     for c in &caveats {
         explanation.push(' ');
         explanation.push_str(&c.explain());

@@ -61,9 +61,15 @@ pub(super) fn second_effect(
     rank(with_first, &trial, &mut ev, &rest, level, cfg, ch);
     let before = mean_fit(with_first, held.1, &Horizon::REPORT);
     let est_set = Set::new(with_first, held.0);
+    // the held-out fits of the effect picked, when its gain named it (kept for the
+    // partner clause below)
+    let mut pick_fits = None;
     let (pick, named) = ev.iter().enumerate().find_map(|(i, e)| {
+        pick_fits = None;
         named_second(e, level, || {
-            frozen_gain(with_first, e, &est_set, held.1, &before, cfg.parallel).0
+            let (g, fits) = frozen_gain(with_first, e, &est_set, held.1, &before, cfg.parallel);
+            pick_fits = Some(fits);
+            g
         })
         .map(|n| (i, n))
     })?;
@@ -78,7 +84,11 @@ pub(super) fn second_effect(
             let (_, fits) = frozen_gain(with_first, e, &est_set, held.1, &before, cfg.parallel);
             compared_gains(&fits, &before)
         };
-        let (gp, gj) = (held_out(&ev[pick]), held_out(&ev[j]));
+        let gp = match &pick_fits {
+            Some(fits) => compared_gains(fits, &before),
+            None => held_out(&ev[pick]),
+        };
+        let gj = held_out(&ev[j]);
         if outpredicts(gj, gp) {
             let words = format!(
                 "; named ahead of {} beside the first effect: it predicts the held-out \

@@ -588,6 +588,7 @@ pub(super) fn evidence(kind: EffectKind, p: f64, p_yaw: f64, channel_material: b
         channel_material,
         reference: None,
         speed_only: false,
+        p_moment: None,
     }
 }
 
@@ -788,7 +789,7 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
     assert!((ev[0].p - 8e-4).abs() < 1e-15, "{}", ev[0].p);
     assert!(ev[0].channel_material);
     assert!(ev[0].words.contains("present"), "{}", ev[0].words);
-    assert!(current_or_leeway(&ev, &["wind", "current"], false).is_none());
+    assert!(current_or_leeway(&ev).is_none());
     // the same speed evidence without a yaw moment: a current, wind moved behind it
     let mut ev = vec![
         evidence(EffectKind::Wind, 1e-6, 0.3, true),
@@ -798,15 +799,21 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
     assert_eq!(kinds(&ev), [EffectKind::Current, EffectKind::Wind]);
     assert_eq!(ev[1].p, 1e-6);
     // named from the ground track alone, without an anemometer: a caveat says a wind's
-    // leeway would look the same, with the p applied (2 × 0.05); none with an anemometer,
-    // none when no current is named
-    let c = current_or_leeway(&ev, &["current", ""], false).unwrap();
+    // leeway would look the same, with the p applied (2 × 0.05); none for the wind, none
+    // where an anemometer decided
+    let c = current_or_leeway(&ev).unwrap();
     assert_eq!(c, Caveat::CurrentOrLeeway { p_moment: 0.1 });
     let json = serde_json::to_value(&c).unwrap();
     assert_eq!(json["caveat"], "current-or-leeway");
     assert!(c.explain().contains("p = 1.0e-1"), "{}", c.explain());
-    assert!(current_or_leeway(&ev, &["current", ""], true).is_none());
-    assert!(current_or_leeway(&ev, &["dead-time", ""], false).is_none());
+    assert!(current_or_leeway(&ev[1..]).is_none());
+    let mut ev = vec![
+        evidence(EffectKind::Current, 1e-7, 0.05, true),
+        evidence(EffectKind::Wind, 1e-6, 0.3, true),
+    ];
+    current_or_wind(&mut ev, level, alpha, true, Some(0.5));
+    assert_eq!(kinds(&ev), [EffectKind::Current, EffectKind::Wind]);
+    assert!(current_or_leeway(&ev).is_none());
     // without speed over ground, or with neither significant, nothing changes
     for (speed, p) in [(false, 1e-7), (true, 0.5)] {
         let mut ev = vec![

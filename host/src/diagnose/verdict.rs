@@ -46,6 +46,9 @@ pub(super) struct Evidence {
     /// Current or wind shown by speed over ground while the yaw channel shows no
     /// heading-dependent moment ([`current_or_wind`]).
     pub(super) speed_only: bool,
+    /// The yaw channel's heading-dependent moment, when it decided between current and wind
+    /// (no anemometer): its p-value ([`current_or_wind`]).
+    pub(super) p_moment: Option<f64>,
 }
 
 /// One effect kind's evidence: its statistic `D` against its bootstrap null, in words
@@ -83,6 +86,7 @@ pub(super) fn effect_evidence(
         channel_material: false,
         reference: stat.reference,
         speed_only: false,
+        p_moment: None,
     };
     let pct = 100.0 * (1.0 - (-d / tn.max(1) as f64).exp());
     yaw_words(&mut ev, ts, pct);
@@ -194,6 +198,10 @@ pub(super) fn current_or_wind(
     ev[iw].words.push_str(&words);
     ev[ic].speed_only = !wind;
     ev[iw].speed_only = !wind;
+    if anemometer.is_none() {
+        ev[ic].p_moment = Some(p_moment);
+        ev[iw].p_moment = Some(p_moment);
+    }
     if wind {
         let heading_p = ev[ic].p.min(ev[iw].p);
         let cm = ev[ic].channel_material;
@@ -658,22 +666,17 @@ pub(super) fn caveats(
 }
 
 /// The caveat for a current named from the ground track alone ([`Caveat::CurrentOrLeeway`]):
-/// `named` (the verdict, then its second effect) holds a current, no anemometer decided
-/// between current and wind ([`current_or_wind`]), and the yaw channel's heading-dependent
-/// moment was absent; its p-value is the one that test applied.
-pub(super) fn current_or_leeway(
-    ev: &[Evidence],
-    named: &[&str],
-    anemometer: bool,
+/// of the effects `named` (the verdict's evidence, then its second effect's), a current that
+/// the yaw channel's heading-dependent moment, not an anemometer, set apart from wind
+/// ([`current_or_wind`]), and found absent.
+pub(super) fn current_or_leeway<'a>(
+    named: impl IntoIterator<Item = &'a Evidence>,
 ) -> Option<Caveat> {
-    let cur = ev.iter().find(|e| e.kind == EffectKind::Current)?;
-    if anemometer || !cur.speed_only || !named.contains(&EffectKind::Current.name()) {
-        return None;
-    }
-    let wind = ev.iter().find(|e| e.kind == EffectKind::Wind)?;
-    Some(Caveat::CurrentOrLeeway {
-        p_moment: moment_p(cur, wind),
-    })
+    named
+        .into_iter()
+        .filter(|e| e.kind == EffectKind::Current && e.speed_only)
+        .find_map(|e| e.p_moment)
+        .map(|p_moment| Caveat::CurrentOrLeeway { p_moment })
 }
 
 /// The yaw channel's heading-dependent moment: the better of current's and wind's yaw
