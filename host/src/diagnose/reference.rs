@@ -6,7 +6,7 @@ use yawcast_shared::model::EffectKind;
 
 use super::evidence::Set;
 use super::DiagnoseConfig;
-use crate::diagnose::augment::AugmentConfig;
+use crate::diagnose::augment::{describe, forward, AugmentConfig};
 use crate::effects::{def, Role};
 use crate::identify::model::Model;
 use crate::identify::pem::{self, PemConfig};
@@ -22,9 +22,10 @@ pub(super) struct RefActuator {
 }
 
 /// The reference's own steering-gear physics (module docs): forward selection over the
-/// actuator effects the model lacks, on the reference records, by [`crate::diagnose::augment`]'s rule
-/// (re-identified, kept only when the held-out part of the reference pays for it or the
-/// reference supports it decisively). `None` when it keeps none.
+/// actuator effects the model lacks, on the reference records, by
+/// [`crate::diagnose::augment`]'s rule (re-identified, kept only when the held-out part of
+/// the reference pays for it or the reference supports it decisively). `None` when it keeps
+/// none.
 pub(super) fn reference_actuator(
     model: &Model,
     reference: &[Record],
@@ -52,7 +53,7 @@ pub(super) fn reference_actuator(
         input_in_sample: true,
         ..cfg.augment.clone()
     };
-    let f = crate::diagnose::augment::forward(model, reference, &[], &kinds, &acfg).ok()?;
+    let f = forward(model, reference, &[], &kinds, &acfg).ok()?;
     if f.added.is_empty() || !f.model.is_stable() {
         return None;
     }
@@ -65,7 +66,7 @@ pub(super) fn reference_actuator(
         .added
         .iter()
         .filter_map(|k| f.model.effect(*k))
-        .map(|e| crate::diagnose::augment::describe(e, model.ts))
+        .map(|e| describe(e, model.ts))
         .collect();
     let words = format!(
         " The reference records show steering-gear physics of their own that the linear \
@@ -128,7 +129,6 @@ pub(super) fn foreign(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::diagnose::augment::forward;
     use crate::diagnose::tests::{identify, records};
     use crate::identify::model::Effect;
 

@@ -23,11 +23,12 @@ use crate::io::data::Record;
 /// wind share speed over ground's evidence, so beside either the other is not a second
 /// effect. The others are ranked by the first stage's rule ([`rank`]); the second effect is
 /// the first of them that [`named_second`] accepts, its held-out gain measured on `held`
-/// (estimation part, held-out part); `None` without one. When that is current or wind and the other is significant too, the one that
-/// predicts the held-out records better at both horizons ([`outpredicts`]: the ranking rule's
-/// second clause) is named — unless the records log the anemometer, whose true wind decides
-/// between them as in the first stage ([`super::rule::outpredicted`]). Beside the effect, why
-/// it is named, in words (its channel, its held-out gain, or the second clause).
+/// (estimation part, held-out part); `None` without one. When that is current or wind and
+/// the other is significant too, the one that predicts the held-out records better at both
+/// horizons ([`outpredicts`]: the ranking rule's second clause) is named — unless the records
+/// log the anemometer, whose true wind decides between them as in the first stage
+/// ([`super::rule::outpredicted`]). Beside the effect, why it is named, in words (its
+/// channel, its held-out gain, or the second clause).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn second_effect(
     base: &Model,
