@@ -529,6 +529,10 @@ pub fn diagnose(
         verdict_ev.into_iter().chain(then.as_ref().map(|(e, _)| e)),
     ));
     let then = then.map(|(e, _)| e.kind.name().to_string());
+    if then.as_deref() == Some(EffectKind::Current.name()) {
+        // a current named second: what speed over ground cannot show does not qualify it
+        caveats.retain(|c| !matches!(c, Caveat::CurrentResolution { .. }));
+    }
     for c in &caveats {
         explanation.push(' ');
         explanation.push_str(&c.explain());

@@ -159,7 +159,55 @@ pub(super) fn named_second(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::diagnose::tests::evidence;
+    use crate::diagnose::tests::{evidence, identify, noise, records};
+    use crate::diagnose::{diagnose, Caveat};
+    use crate::sim::{simulate, Scenario, Ship, SimEffect};
+
+    #[test]
+    fn a_current_named_second_from_the_ground_track_carries_its_own_caveat() {
+        // the built-in ship, a dead time and a current hidden, no anemometer: the dead
+        // time first, then the current, seen on the ground track alone — so the caveat
+        // says a wind's leeway would look the same, and the one on how weak a current
+        // speed over ground can show (for verdicts without one) is not given
+        let refs = records(None, &[900, 901, 902]);
+        let model = identify(&refs);
+        let cfg = DiagnoseConfig {
+            seed: 1,
+            confirm: false,
+            ..DiagnoseConfig::default()
+        };
+        let sc = Scenario {
+            effects: vec![
+                SimEffect::hidden(EffectKind::DeadTime, 1.0),
+                SimEffect::hidden(EffectKind::Current, 1.0),
+            ],
+            noise: noise(),
+            ..Scenario::default()
+        };
+        let two: Vec<Record> = [100u64, 101, 102]
+            .iter()
+            .map(|&s| simulate(&Ship::default_lng(), &sc, s).unwrap())
+            .collect();
+        let d = diagnose(&model, &refs, &two, &[], &cfg).unwrap();
+        assert_eq!(d.verdict, "dead-time", "{}", d.explanation);
+        assert_eq!(d.then.as_deref(), Some("current"), "{}", d.explanation);
+        let leeway = d.caveats.iter().find_map(|c| match c {
+            Caveat::CurrentOrLeeway { p_moment } => Some(*p_moment),
+            _ => None,
+        });
+        // the moment's p (0.14 here) is what the test applied: absent at α
+        assert!(leeway.is_some_and(|p| p >= cfg.alpha), "{:?}", d.caveats);
+        assert!(
+            !d.caveats
+                .iter()
+                .any(|c| matches!(c, Caveat::CurrentResolution { .. })),
+            "{:?}",
+            d.caveats
+        );
+        assert!(d
+            .explanation
+            .contains("cannot tell a current from the leeway"));
+    }
 
     #[test]
     fn a_second_effect_is_named_by_its_channel_or_by_what_it_wins_back() {

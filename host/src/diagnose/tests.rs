@@ -15,7 +15,7 @@ use crate::identify::pem::{self, PemConfig};
 use crate::sim::{simulate, NoiseSpec, Scenario, Ship, SimEffect};
 use crate::stats::{chi2_sf, standard_normal as gauss};
 
-fn noise() -> NoiseSpec {
+pub(crate) fn noise() -> NoiseSpec {
     NoiseSpec {
         gyro_std_degps: 0.03,
         heading_std_deg: 0.1,

@@ -510,7 +510,7 @@ pub enum Caveat {
     NoSpeedOverGround,
     /// Speed over ground cannot show a current weaker than `smallest_mps` on these records
     /// (heading range, speed lost in turns): a verdict other than current does not rule
-    /// one out.
+    /// one out (not given when a current is named, first or second).
     CurrentResolution {
         /// The smallest current (m/s) the records show at the level applied, in any
         /// direction.
