@@ -37,7 +37,9 @@
 //!   bootstrap's replicates are (almost) all 0 and say nothing of how far two effect-free
 //!   sets of a nonlinear hull differ. Each part of the reference (a record, or a piece of
 //!   one) is therefore also measured as a trial against the others, `D` scaled to the
-//!   trials; p is the larger of the two nulls' (`null::with_spread`).
+//!   trials; p is the larger of the two nulls' (`null::with_spread`). Where the parts agree
+//!   too, neither null has width: no p-value is taken below one free parameter's
+//!   likelihood ratio on white innovations, χ²₁ (`Null::p`).
 //! - **Every channel.** Heading separates a gyro bias from a yaw moment: over a record,
 //!   `mean(r) − mean(dψ/dt)` equals the rate-sensor offset and is ≈ 0 for a true moment.
 //!   Speed over ground modulated with heading (harmonics in ψ) reveals current and wind,
@@ -194,10 +196,10 @@ pub struct Ranked {
     pub statistic: f64,
     /// p-value against the calibrated null.
     pub p_value: f64,
-    /// Likelihood gain above what noise alone gives: the statistic less its null mean (for
-    /// a channel statistic, its χ² less its degrees of freedom). Effects are ranked by it:
-    /// far-tail p-values rest on the shape fitted to the null replicates and are not
-    /// comparable between effects.
+    /// Likelihood gain above what noise alone gives: the statistic less its null mean,
+    /// taken as at least 1, χ²₁'s (for a channel statistic, its χ² less its degrees of
+    /// freedom). Effects are ranked by it: far-tail p-values rest on the shape fitted to
+    /// the null replicates and are not comparable between effects.
     pub above_noise: f64,
     /// Held-out fit gain (percentage points, at the effect's horizon: 10 steps for actuator and
     /// hull effects, `sim` for slow ones) of the model with the effect added (θ frozen, the
