@@ -159,9 +159,9 @@ pub(super) fn named_second(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::diagnose::tests::{evidence, identify, noise, records};
+    use crate::diagnose::tests::{evidence, hidden_records, identify, records};
     use crate::diagnose::{diagnose, Caveat};
-    use crate::sim::{simulate, Scenario, Ship, SimEffect};
+    use crate::sim::{Ship, SimEffect};
 
     #[test]
     fn a_current_named_second_from_the_ground_track_carries_its_own_caveat() {
@@ -176,18 +176,11 @@ mod tests {
             confirm: false,
             ..DiagnoseConfig::default()
         };
-        let sc = Scenario {
-            effects: vec![
-                SimEffect::hidden(EffectKind::DeadTime, 1.0),
-                SimEffect::hidden(EffectKind::Current, 1.0),
-            ],
-            noise: noise(),
-            ..Scenario::default()
-        };
-        let two: Vec<Record> = [100u64, 101, 102]
-            .iter()
-            .map(|&s| simulate(&Ship::default_lng(), &sc, s).unwrap())
-            .collect();
+        let hidden = vec![
+            SimEffect::hidden(EffectKind::DeadTime, 1.0),
+            SimEffect::hidden(EffectKind::Current, 1.0),
+        ];
+        let two = hidden_records(&Ship::default_lng(), hidden, &[100, 101, 102]);
         let d = diagnose(&model, &refs, &two, &[], &cfg).unwrap();
         assert_eq!(d.verdict, "dead-time", "{}", d.explanation);
         assert_eq!(d.then.as_deref(), Some("current"), "{}", d.explanation);

@@ -15,7 +15,7 @@ use crate::identify::pem::{self, PemConfig};
 use crate::sim::{simulate, NoiseSpec, Scenario, Ship, SimEffect};
 use crate::stats::{chi2_sf, standard_normal as gauss};
 
-pub(crate) fn noise() -> NoiseSpec {
+fn noise() -> NoiseSpec {
     NoiseSpec {
         gyro_std_degps: 0.03,
         heading_std_deg: 0.1,
@@ -33,11 +33,17 @@ pub(crate) fn ship_records(
     kind: Option<(EffectKind, f64)>,
     seeds: &[u64],
 ) -> Vec<Record> {
-    let mut sc = match kind {
-        Some((k, s)) => Scenario::with_effect(SimEffect::hidden(k, s)),
-        None => Scenario::default(),
+    let effects = kind.map(|(k, s)| SimEffect::hidden(k, s)).into_iter();
+    hidden_records(ship, effects.collect(), seeds)
+}
+
+/// Noisy records of `ship` with `effects` hidden together.
+pub(crate) fn hidden_records(ship: &Ship, effects: Vec<SimEffect>, seeds: &[u64]) -> Vec<Record> {
+    let sc = Scenario {
+        effects,
+        noise: noise(),
+        ..Scenario::default()
     };
-    sc.noise = noise();
     seeds
         .par_iter()
         .map(|&s| simulate(ship, &sc, s).unwrap())
@@ -860,18 +866,11 @@ fn a_second_effect_is_measured_against_the_model_with_the_first() {
         confirm: false,
         ..DiagnoseConfig::default()
     };
-    let mut sc = Scenario {
-        effects: vec![
-            SimEffect::hidden(EffectKind::Saturation, 1.0),
-            SimEffect::hidden(EffectKind::NonlinearDamping, 1.0),
-        ],
-        ..Scenario::default()
-    };
-    sc.noise = noise();
-    let two: Vec<Record> = [40u64, 41, 42]
-        .par_iter()
-        .map(|&s| simulate(&Ship::default_lng(), &sc, s).unwrap())
-        .collect();
+    let hidden = vec![
+        SimEffect::hidden(EffectKind::Saturation, 1.0),
+        SimEffect::hidden(EffectKind::NonlinearDamping, 1.0),
+    ];
+    let two = hidden_records(&Ship::default_lng(), hidden, &[40, 41, 42]);
     let d = diagnose(&model, &refs, &two, &[], &cfg).unwrap();
     assert_eq!(d.verdict, "saturation", "{}", d.explanation);
     assert_eq!(

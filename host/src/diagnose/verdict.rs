@@ -517,8 +517,8 @@ pub enum Caveat {
         smallest_mps: f64,
     },
     /// A current named from speed over ground alone, with no anemometer: the wind's leeway
-    /// sets the ship over ground as a current does, and the yaw channel shows no
-    /// heading-dependent moment that would tell the wind ([`current_or_leeway`]).
+    /// sets the ship over ground as a current does, and the yaw channel, which decides
+    /// between the two without an anemometer, shows no heading-dependent moment.
     CurrentOrLeeway {
         /// p-value of the yaw channel's heading-dependent moment (absent: ≥ α).
         p_moment: f64,
