@@ -4,7 +4,7 @@
 #
 #   bench/worlds/run.sh [--yawcast PATH] [--work DIR] [--worlds LIST] [--seeds N]
 #                       [--strengths LIST] [--effects LIST] [--jobs J] [--log-wind]
-#                       [--augment] [--won-back]
+#                       [--augment] [--won-back] [--trial-input KIND] [--ref-input KIND]
 #
 #   --yawcast PATH    the binary (default: build the ci profile and use it)
 #   --work DIR        records, models and diagnoses (default target/bench-worlds)
@@ -31,6 +31,11 @@
 #                     writes without and with `--more`; won back = (augmented − linear) /
 #                     (oracle − linear) where the linear model is ≥ 3 pp below the oracle
 #                     (median per world and strength)
+#   --trial-input KIND  the trials' (and the validation record's) command, as `simulate
+#                     --input` (default prbs, the reference's own kind with other switching
+#                     times; e.g. zigzag:20/20, the manoeuvre of most model tests)
+#   --ref-input KIND  the reference's command (default prbs); a zig-zag reference starts
+#                     from other headings than the trials' (other seeds)
 #
 # Per world: the reference is 3 records of the world's identification input (seeds 900–902,
 # gyro noise 0.02 °/s, heading noise 0.1°) and the model identified on them; each case is 3
@@ -55,6 +60,8 @@ jobs=2
 logwind=""
 augment=0
 wonback=0
+trialinput=prbs
+refinput=prbs
 while [ $# -gt 0 ]; do
     case "$1" in
         --yawcast) yawcast="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
@@ -67,7 +74,9 @@ while [ $# -gt 0 ]; do
         --log-wind) logwind="--log-wind"; shift ;;
         --augment) augment=1; shift ;;
         --won-back) wonback=1; shift ;;
-        -h|--help) sed -n '2,41p' "$0"; exit 0 ;;
+        --trial-input) trialinput="$2"; shift 2 ;;
+        --ref-input) refinput="$2"; shift 2 ;;
+        -h|--help) sed -n '2,46p' "$0"; exit 0 ;;
         *) echo "unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
@@ -77,6 +86,7 @@ if [ -z "$yawcast" ]; then
 fi
 mkdir -p "$work"
 export YAWCAST="$yawcast" WORK="$work" LOGWIND="$logwind" AUGMENT="$augment" WONBACK="$wonback"
+export TRIALINPUT="$trialinput"
 
 # a world's `simulate` arguments, one a line: NAME, or NAME@L for the world scaled to L m
 world_args() {
@@ -105,7 +115,7 @@ case_run() {
         eff+=(--strength "$strength")
     fi
     "$YAWCAST" simulate "${sim[@]}" "${eff[@]}" --records 3 --seed $((100 * seed)) \
-        --gyro-noise 0.03 --heading-noise 0.2 --speed-noise 0.02 $LOGWIND \
+        --input "$TRIALINPUT" --gyro-noise 0.03 --heading-noise 0.2 --speed-noise 0.02 $LOGWIND \
         --out "$dir/trial.csv" >"$dir/simulate.log" 2>&1
     local refs=()
     for i in 1 2 3; do refs+=(--reference "$WORK/$world/ref-$i.csv"); done
@@ -142,9 +152,9 @@ print("+".join(e) if e else "none")' "$dir/augment.json")
         local fit10='import json,sys
 print(json.load(open(sys.argv[1]))["records"][0]["fit"]["10"])'
         if "$YAWCAST" simulate "${sim[@]}" "${eff[@]}" --records 1 \
-            --seed $((100 * seed + 50)) --gyro-noise 0.03 --heading-noise 0.2 \
-            --speed-noise 0.02 $LOGWIND --oracle-horizon 10 --out "$dir/val.csv" \
-            --json "$dir/val.json" >"$dir/won-back.log" 2>&1 \
+            --seed $((100 * seed + 50)) --input "$TRIALINPUT" --gyro-noise 0.03 \
+            --heading-noise 0.2 --speed-noise 0.02 $LOGWIND --oracle-horizon 10 \
+            --out "$dir/val.csv" --json "$dir/val.json" >"$dir/won-back.log" 2>&1 \
             && "$YAWCAST" identify "${data[@]}" --out "$dir/linear" \
                 >>"$dir/won-back.log" 2>&1 \
             && "$YAWCAST" augment --model "$WORK/$world/ref.postcard" --effect auto \
@@ -185,7 +195,7 @@ for w in "${world_list[@]}"; do
     mkdir -p "$work/$w"
     if [ ! -f "$work/$w/ref.postcard" ]; then
         mapfile -t sim < <(world_args "$w")
-        "$yawcast" simulate "${sim[@]}" --records 3 --seed 900 --gyro-noise 0.02 \
+        "$yawcast" simulate "${sim[@]}" --records 3 --seed 900 --input "$refinput" --gyro-noise 0.02 \
             --heading-noise 0.1 $logwind --out "$work/$w/ref.csv" >"$work/$w/ref.log" 2>&1
         "$yawcast" identify --data "$work/$w/ref-1.csv" --data "$work/$w/ref-2.csv" \
             --data "$work/$w/ref-3.csv" --out "$work/$w/ref" >>"$work/$w/ref.log" 2>&1
@@ -205,12 +215,12 @@ done
 xargs -P "$jobs" -L 1 bash -c 'case_run "$@"' _ <"$list" | sort >"$work/cases.tsv"
 secs=$(( $(date +%s) - start ))
 
-python3 - "$work/cases.tsv" "$secs" "$(nproc)" <<'EOF'
+python3 - "$work/cases.tsv" "$secs" "$(nproc)" "$trialinput" "$refinput" <<'EOF'
 import collections, sys
 allrows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
 rows = [r for r in allrows if "+" not in r[2]]
 pairs = [r for r in allrows if "+" in r[2]]
-secs, cores = sys.argv[2], sys.argv[3]
+secs, cores, trialinput, refinput = sys.argv[2], sys.argv[3], sys.argv[4], sys.argv[5]
 def accounted(augmented):
     """The effects the model augment writes accounts for: a current in the yaw-rate model
     or in its heading/track part."""
@@ -219,6 +229,8 @@ order = ["lng", "kvlcc2", "mariner"]
 worlds = sorted({r[0] for r in allrows},
                 key=lambda w: (order.index(w) if w in order else len(order), w))
 print(f"# Cross-world diagnosis ({len(allrows)} cases, {secs} s on {cores} cores)\n")
+if (trialinput, refinput) != ("prbs", "prbs"):
+    print(f"Trials sailed with `{trialinput}`, the reference with `{refinput}`.\n")
 if pairs:
     print("## Two effects: both named by the ranked verdict (verdict, then)\n")
     aug = any(r[6] != "-" for r in pairs)
