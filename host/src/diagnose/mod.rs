@@ -530,6 +530,12 @@ pub fn diagnose(
     caveats.extend(verdict::current_or_leeway(
         verdict_ev.into_iter().chain(then.as_ref().map(|(e, _)| e)),
     ));
+    let named: Vec<EffectKind> = verdict_ev
+        .map(|e| e.kind)
+        .into_iter()
+        .chain(then.as_ref().map(|(e, _)| e.kind))
+        .collect();
+    caveats.extend(verdict::clip_or_dead_band(&named, est));
     let then = then.map(|(e, _)| e.kind.name().to_string());
     if then.as_deref() == Some(EffectKind::Current.name()) {
         // a current named second: what speed over ground cannot show does not qualify it

@@ -523,6 +523,15 @@ pub enum Caveat {
         /// p-value of the yaw channel's heading-dependent moment (absent: ≥ α).
         p_moment: f64,
     },
+    /// An angle limit or a dead band named (first or second) on trials whose commands hold
+    /// one magnitude — a zig-zag's ±20°: a limit below it and a dead band take the same off
+    /// every command, and the records cannot tell them apart.
+    ClipOrDeadBand {
+        /// The one magnitude (deg).
+        magnitude_deg: f64,
+        /// Share of the commanded samples (|δ| > 0) at it.
+        share: f64,
+    },
     /// A significant effect that does not improve held-out prediction was named behind
     /// the verdict by the ranking rule.
     PassedOver {
@@ -596,6 +605,18 @@ impl Caveat {
                  records cannot tell a current from the leeway of a wind too weak to turn the \
                  ship; the anemometer's columns (apparent wind speed and angle) would.",
                 fmt_p(*p_moment)
+            ),
+            Caveat::ClipOrDeadBand {
+                magnitude_deg,
+                share,
+            } => format!(
+                "The trials' commands hold one magnitude (±{magnitude_deg:.1}° in {:.0} % of \
+                 the commanded samples): an angle limit below it and a dead band take the same \
+                 off every such command and differ only in how the gear moves between them, \
+                 which the model approximates. The records cannot tell a saturation from a \
+                 dead band; commands of several magnitudes would (a PRBS, or zig-zags of two \
+                 amplitudes).",
+                100.0 * share
             ),
             Caveat::PassedOver { effect } => {
                 let kind = EffectKind::from_name(effect);
@@ -679,6 +700,40 @@ pub(super) fn current_or_leeway<'a>(
         .map(|p_moment| Caveat::CurrentOrLeeway { p_moment })
 }
 
+/// Share of the commanded samples at one magnitude from which [`clip_or_dead_band`] says
+/// the records cannot tell an angle limit from a dead band: nine in ten. The two differ
+/// on every command of another magnitude (by up to the dead band's width), so a tenth of
+/// the samples at other magnitudes — three minutes of a half-hour record — tells them.
+const ONE_MAGNITUDE_SHARE: f64 = 0.9;
+
+/// The caveat for an angle limit or a dead band named on commands of one magnitude
+/// ([`Caveat::ClipOrDeadBand`]): `named`, the verdict's effect and its second; `est`, the
+/// trials. The magnitude is the commonest |δ| to 0.1°, the share is over the samples whose
+/// command is not 0.
+pub(super) fn clip_or_dead_band(named: &[EffectKind], est: &[Record]) -> Option<Caveat> {
+    if !named
+        .iter()
+        .any(|k| matches!(k, EffectKind::Saturation | EffectKind::DeadBand))
+    {
+        return None;
+    }
+    let mut bins: BTreeMap<i64, usize> = BTreeMap::new();
+    let mut commanded = 0usize;
+    for u in est.iter().flat_map(|r| r.u.iter()) {
+        let m = (u.abs() * 10.0).round();
+        if m.is_finite() && m > 0.0 {
+            *bins.entry(m as i64).or_default() += 1;
+            commanded += 1;
+        }
+    }
+    let (&bin, &count) = bins.iter().max_by_key(|(b, c)| (**c, -**b))?;
+    let share = count as f64 / commanded as f64;
+    (share >= ONE_MAGNITUDE_SHARE).then_some(Caveat::ClipOrDeadBand {
+        magnitude_deg: bin as f64 / 10.0,
+        share,
+    })
+}
+
 /// The yaw channel's heading-dependent moment: the better of current's and wind's yaw
 /// p-values, Bonferroni over the two.
 fn moment_p(current: &Evidence, wind: &Evidence) -> f64 {
@@ -759,5 +814,52 @@ mod tests {
         // gains have no grid
         assert_eq!(grid_gap(0.2, &[Effect::GyroBias { d_y: 0.0 }], 0.5), None);
         assert_eq!(grid_gap(1.0, &[dead(2)], 0.5), None);
+    }
+
+    #[test]
+    fn a_clip_and_a_dead_band_look_alike_on_commands_of_one_magnitude() {
+        let rec = |u: Vec<f64>| Record::from_uy("r", 1.0, u.clone(), vec![0.0; u.len()]);
+        // a zig-zag: ±20° throughout, a straight start at 0° not counted
+        let zz: Vec<f64> = (0..300)
+            .map(|i| match i {
+                0..10 => 0.0,
+                _ if (i / 40) % 2 == 0 => 20.0,
+                _ => -20.0,
+            })
+            .collect();
+        let c = clip_or_dead_band(&[EffectKind::DeadBand], &[rec(zz.clone())]).unwrap();
+        assert_eq!(
+            c,
+            Caveat::ClipOrDeadBand {
+                magnitude_deg: 20.0,
+                share: 1.0
+            }
+        );
+        assert!(c.explain().contains("±20.0° in 100 %"), "{}", c.explain());
+        let json = serde_json::to_value(&c).unwrap();
+        assert_eq!(json["caveat"], "clip-or-dead-band");
+        assert_eq!(json["magnitude_deg"], 20.0);
+        // named second, the same
+        let k = [EffectKind::Current, EffectKind::Saturation];
+        assert!(clip_or_dead_band(&k, &[rec(zz.clone())]).is_some());
+        // neither named: none
+        assert!(clip_or_dead_band(&[EffectKind::DeadTime], &[rec(zz.clone())]).is_none());
+        // a PRBS of four magnitudes: a quarter at each, the records tell them apart
+        let prbs: Vec<f64> = (0..400)
+            .map(|i| [5.0, -10.0, 15.0, -20.0][(i / 7) % 4])
+            .collect();
+        assert!(clip_or_dead_band(&[EffectKind::DeadBand], &[rec(prbs.clone())]).is_none());
+        // 85 % at one magnitude: below the share, no caveat; 90 %: the caveat
+        let mix =
+            |k: usize| -> Vec<f64> { (0..100).map(|i| if i < k { 20.0 } else { 7.5 }).collect() };
+        assert!(clip_or_dead_band(&[EffectKind::DeadBand], &[rec(mix(85))]).is_none());
+        let c = clip_or_dead_band(&[EffectKind::DeadBand], &[rec(mix(90))]).unwrap();
+        assert_eq!(
+            c,
+            Caveat::ClipOrDeadBand {
+                magnitude_deg: 20.0,
+                share: 0.9
+            }
+        );
     }
 }
