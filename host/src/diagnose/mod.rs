@@ -87,6 +87,7 @@
 
 pub mod augment;
 mod channels;
+mod commands;
 pub mod compare;
 mod evidence;
 mod null;
@@ -535,8 +536,8 @@ pub fn diagnose(
         .into_iter()
         .chain(then.as_ref().map(|(e, _)| e.kind))
         .collect();
-    caveats.extend(verdict::clip_or_dead_band(&named, est));
-    caveats.extend(verdict::other_manoeuvre(est, reference));
+    caveats.extend(commands::clip_or_dead_band(&named, est));
+    caveats.extend(commands::other_manoeuvre(est, reference));
     let then = then.map(|(e, _)| e.kind.name().to_string());
     if then.as_deref() == Some(EffectKind::Current.name()) {
         // a current named second: what speed over ground cannot show does not qualify it

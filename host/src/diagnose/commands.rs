@@ -1,0 +1,151 @@
+//! What the trials' commands alone say the records cannot tell: an angle limit from a dead
+//! band on commands of one magnitude, and the hull's own nonlinearity on other commands than
+//! the reference's.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use yawcast_shared::model::EffectKind;
+
+use super::verdict::Caveat;
+use crate::io::data::Record;
+
+/// Share of the commanded samples at one magnitude from which [`clip_or_dead_band`] says
+/// the records cannot tell an angle limit from a dead band: nine in ten. The two differ
+/// on every command of another magnitude (by up to the dead band's width), so a tenth of
+/// the samples at other magnitudes — three minutes of a half-hour record — tells them.
+const ONE_MAGNITUDE_SHARE: f64 = 0.9;
+
+/// The caveat for an angle limit or a dead band named on commands of one magnitude
+/// ([`Caveat::ClipOrDeadBand`]): `named`, the verdict's effect and its second; `est`, the
+/// trials. The magnitude is the commonest |δ| to 0.1°, the share is over the samples whose
+/// command is not 0.
+pub(super) fn clip_or_dead_band(named: &[EffectKind], est: &[Record]) -> Option<Caveat> {
+    if !named
+        .iter()
+        .any(|k| matches!(k, EffectKind::Saturation | EffectKind::DeadBand))
+    {
+        return None;
+    }
+    let mut bins: BTreeMap<i64, usize> = BTreeMap::new();
+    let mut commanded = 0usize;
+    for u in est.iter().flat_map(|r| r.u.iter()) {
+        let m = (u.abs() * 10.0).round();
+        if m.is_finite() && m > 0.0 {
+            *bins.entry(m as i64).or_default() += 1;
+            commanded += 1;
+        }
+    }
+    let (&bin, &count) = bins.iter().max_by_key(|(b, c)| (**c, -**b))?;
+    let share = count as f64 / commanded as f64;
+    (share >= ONE_MAGNITUDE_SHARE).then_some(Caveat::ClipOrDeadBand {
+        magnitude_deg: bin as f64 / 10.0,
+        share,
+    })
+}
+
+/// Distance between the trials' and the reference's commands from which [`other_manoeuvre`]
+/// says they were sailed with other manoeuvres: half the trials' command magnitudes where
+/// the reference's are not. Two PRBS sets of other switching times lie 0.06–0.16 apart on
+/// the three test worlds (189 cases each), a zig-zag of ±20° and a PRBS of 5–20° 0.75–0.77.
+const OTHER_MANOEUVRE: f64 = 0.5;
+
+/// The caveat for trials sailed with other commands than the reference's
+/// ([`Caveat::OtherManoeuvre`]): the total-variation distance between the two sets'
+/// distributions of |δ| in 1° bins, given from [`OTHER_MANOEUVRE`] on; `None` without a
+/// reference.
+pub(super) fn other_manoeuvre(est: &[Record], reference: &[Record]) -> Option<Caveat> {
+    let hist = |recs: &[Record]| -> (BTreeMap<i64, f64>, f64) {
+        let mut h: BTreeMap<i64, f64> = BTreeMap::new();
+        let mut n = 0.0;
+        for u in recs.iter().flat_map(|r| r.u.iter()) {
+            if u.is_finite() {
+                *h.entry(u.abs().round() as i64).or_default() += 1.0;
+                n += 1.0;
+            }
+        }
+        (h, n)
+    };
+    let ((ht, nt), (hr, nr)) = (hist(est), hist(reference));
+    if nt == 0.0 || nr == 0.0 {
+        return None;
+    }
+    let bins: BTreeSet<i64> = ht.keys().chain(hr.keys()).copied().collect();
+    let distance = 0.5
+        * bins
+            .iter()
+            .map(|b| {
+                let f = |h: &BTreeMap<i64, f64>, n: f64| h.get(b).copied().unwrap_or(0.0) / n;
+                (f(&ht, nt) - f(&hr, nr)).abs()
+            })
+            .sum::<f64>();
+    (distance >= OTHER_MANOEUVRE).then_some(Caveat::OtherManoeuvre { distance })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_commands_say_what_the_records_cannot_tell() {
+        let rec = |u: Vec<f64>| Record::from_uy("r", 1.0, u.clone(), vec![0.0; u.len()]);
+        // a zig-zag: ±20° throughout, a straight start at 0° not counted
+        let zz: Vec<f64> = (0..300)
+            .map(|i| match i {
+                0..10 => 0.0,
+                _ if (i / 40) % 2 == 0 => 20.0,
+                _ => -20.0,
+            })
+            .collect();
+        let c = clip_or_dead_band(&[EffectKind::DeadBand], &[rec(zz.clone())]).unwrap();
+        assert_eq!(
+            c,
+            Caveat::ClipOrDeadBand {
+                magnitude_deg: 20.0,
+                share: 1.0
+            }
+        );
+        assert!(c.explain().contains("±20.0° in 100 %"), "{}", c.explain());
+        let json = serde_json::to_value(&c).unwrap();
+        assert_eq!(json["caveat"], "clip-or-dead-band");
+        assert_eq!(json["magnitude_deg"], 20.0);
+        // named second, the same
+        let k = [EffectKind::Current, EffectKind::Saturation];
+        assert!(clip_or_dead_band(&k, &[rec(zz.clone())]).is_some());
+        // neither named: none
+        assert!(clip_or_dead_band(&[EffectKind::DeadTime], &[rec(zz.clone())]).is_none());
+        // a PRBS of four magnitudes: a quarter at each, the records tell them apart
+        let prbs: Vec<f64> = (0..392)
+            .map(|i| [5.0, -10.0, 15.0, -20.0][(i / 7) % 4])
+            .collect();
+        assert!(clip_or_dead_band(&[EffectKind::DeadBand], &[rec(prbs.clone())]).is_none());
+        // 85 % at one magnitude: below the share, no caveat; 90 %: the caveat
+        let mix =
+            |k: usize| -> Vec<f64> { (0..100).map(|i| if i < k { 20.0 } else { 7.5 }).collect() };
+        assert!(clip_or_dead_band(&[EffectKind::DeadBand], &[rec(mix(85))]).is_none());
+        let c = clip_or_dead_band(&[EffectKind::DeadBand], &[rec(mix(90))]).unwrap();
+        assert_eq!(
+            c,
+            Caveat::ClipOrDeadBand {
+                magnitude_deg: 20.0,
+                share: 0.9
+            }
+        );
+        // the zig-zag against the PRBS: three quarters of its magnitudes (20°, 290 of 300
+        // samples, against a quarter of the PRBS's) lie where the PRBS's do not
+        let c = other_manoeuvre(&[rec(zz.clone())], &[rec(prbs.clone())]).unwrap();
+        let Caveat::OtherManoeuvre { distance } = c else {
+            panic!("{c:?}")
+        };
+        let want = 0.5 * ((290.0 / 300.0 - 0.25) + 10.0 / 300.0 + 3.0 * 0.25);
+        assert!((distance - want).abs() < 1e-12, "{distance} vs {want}");
+        assert!(c.explain().contains("(75 % of"), "{}", c.explain());
+        assert_eq!(
+            serde_json::to_value(&c).unwrap()["caveat"],
+            "other-manoeuvre"
+        );
+        // alike: none; no reference: none
+        assert!(other_manoeuvre(&[rec(zz.clone())], &[rec(zz.clone())]).is_none());
+        assert!(other_manoeuvre(&[rec(prbs.clone())], &[rec(mix(25))]).is_some());
+        assert!(other_manoeuvre(&[rec(zz)], &[]).is_none());
+    }
+}
