@@ -834,8 +834,8 @@ mod tests {
     }
 
     /// Zig-zag 20°/20° records of the built-in ship, as `bench/worlds/run.sh
-    /// --trial-input zigzag:20/20 --ref-input zigzag:20/20` sails them (trial noise with
-    /// `trial`, the reference's without).
+    /// --trial-input zigzag:20/20 --ref-input zigzag:20/20` sails them (with `trial` the
+    /// trials' noise, else the reference's).
     fn zigzags(seeds: &[u64], trial: bool) -> Vec<Record> {
         let sc = Scenario {
             input: InputSpec::ZigZag {
