@@ -203,8 +203,8 @@ const CROSS_TAUS_S: [f64; 4] = [3.0, 10.0, 30.0, 90.0];
 const CROSS_MIN_SPEED: f64 = 0.1;
 
 /// Coefficients of (sin ψ, cos ψ, sin 2ψ, cos 2ψ) in the lane's component of the ground
-/// velocity; nuisance: one intercept per record, one slope on the heading turned through
-/// ([`turned`]) common to the records, and the lane's own regressors (see [`Lane`]).
+/// velocity; nuisance: one intercept and one slope on the heading turned through
+/// ([`turned`]) per record, and the lane's own regressors (see [`Lane`]).
 /// `shift[i]` circularly shifts record i's heading against its speed (0: aligned);
 /// `remove` is a heading dependence (coefficients as returned) taken out of the target at the
 /// true heading first, as the null draws do. `harm[i]` are record i's [`heading_harmonics`]
@@ -227,7 +227,7 @@ fn sog_harmonics(
         Lane::Along => 2 * nt,
         Lane::Cross => 2 * nt + 2,
     };
-    let p = nr + 1 + 4 + own;
+    let p = 2 * nr + 4 + own;
     let mut xtx = DMatrix::<f64>::zeros(p, p);
     let mut xty = DVector::<f64>::zeros(p);
     let mut x = DVector::<f64>::zeros(p);
@@ -272,8 +272,8 @@ fn sog_harmonics(
             x[i] = 1.0;
             // shifted with the heading: the harmonics and the heading turned through keep
             // their common part in the null draws as in the records
-            x[nr] = turn[(t + sh) % n];
-            let o = nr + 1;
+            x[nr + i] = turn[(t + sh) % n];
+            let o = 2 * nr;
             for (j, hj) in h.iter().enumerate() {
                 x[o + j] = *hj;
             }
@@ -300,7 +300,7 @@ fn sog_harmonics(
         xtx[(j, j)] += ridge;
     }
     let beta = xtx.cholesky()?.solve(&xty);
-    Some(beta.rows(nr + 1, 4).into_owned())
+    Some(beta.rows(2 * nr, 4).into_owned())
 }
 
 /// The heading a record has turned through (rad): unwrapped, less its mean over the record.
@@ -310,10 +310,11 @@ fn sog_harmonics(
 /// (nearly) this one series, and so is whatever the manoeuvre itself moves in step with the
 /// heading (the sway and speed of each swing), which no current causes. A current shows in
 /// how the heading dependence changes *across* headings: through the harmonics' curvature
-/// within a record and their directions between records. The slope is one for all the
-/// records of a set, as the manoeuvre's own response is, where a current's differs from
-/// record to record with the headings each sails. On records that turn through full circles
-/// the turned heading is a slow trend the harmonics hardly see.
+/// within a record and their directions between records. The slope is one per record: one
+/// for all the records of a set, as the manoeuvre's own response would be, left a tanker's
+/// slow fall of speed over its own turning history to the harmonics (KVLCC2: a wind read on
+/// effect-free trials with the anemometer showing none). On records that turn through full
+/// circles the turned heading is a slow trend the harmonics hardly see.
 fn turned(psi: &[f64]) -> Vec<f64> {
     let mut out = Vec::with_capacity(psi.len());
     let mut acc = 0.0;

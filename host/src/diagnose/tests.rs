@@ -391,11 +391,11 @@ fn course_over_ground_shows_a_current_a_tanker_turns_too_slowly_for() {
     let nc = n.cross.unwrap();
     assert!(n.test(true).2 > level, "{n:?}");
     assert!(nc.speed_dir().0 < 0.1, "{nc:?}");
-    // and the records say how small a current they would show: under 1 m/s, where the
-    // records turn through 126–197° (those with the current, 228–271°: 0.07 m/s)
-    assert!(s.smallest_current(level) < 0.1, "{s:?}");
+    // and the records say how small a current they would show: under 1.5 m/s, where the
+    // records turn through 126–197° (those with the current, 228–271°: 0.1 m/s)
+    assert!(s.smallest_current(level) < 0.12, "{s:?}");
     assert!(
-        n.smallest_current(level) < 1.0,
+        n.smallest_current(level) < 1.5,
         "{}",
         n.smallest_current(level)
     );
