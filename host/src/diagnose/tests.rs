@@ -366,7 +366,7 @@ fn course_over_ground_shows_a_current_a_tanker_turns_too_slowly_for() {
     assert!(s.test(true).2 < 1e-9, "{s:?}");
     // speed over ground alone (the slow fall of speed over the turning history taken by
     // the surge lags and the slope on the heading turned through): the hidden current's
-    // size, but in its worst direction no finer than 0.3 m/s
+    // size, but in its worst direction no finer than 0.5 m/s
     let bare = |v: &[Record]| -> Vec<Record> {
         let no_cog = |r: &Record| Record {
             cog: None,
@@ -380,9 +380,9 @@ fn course_over_ground_shows_a_current_a_tanker_turns_too_slowly_for() {
         (along.amp1 - speed_mps).abs() < 0.05 * speed_mps,
         "{along:?}"
     );
-    assert!(along.smallest_current(level) > 0.3, "{along:?}");
+    assert!(along.smallest_current(level) > 0.5, "{along:?}");
     assert!(
-        s.smallest_current(level) < 0.25 * along.smallest_current(level),
+        s.smallest_current(level) < 0.2 * along.smallest_current(level),
         "{s:?}"
     );
     // effect-free trials sailed with other inputs and noise: no current
