@@ -1,6 +1,6 @@
 //! What the trials' commands alone say the records cannot tell: an angle limit from a dead
-//! band on commands of one magnitude, and the hull's own nonlinearity on other commands than
-//! the reference's.
+//! band on commands of one magnitude, a slew limit from a dead time on changes of one size,
+//! and the hull's own nonlinearity on other commands than the reference's.
 
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -39,6 +39,43 @@ pub(super) fn clip_or_dead_band(named: &[EffectKind], est: &[Record]) -> Option<
     let share = count as f64 / commanded as f64;
     (share >= ONE_MAGNITUDE_SHARE).then_some(Caveat::ClipOrDeadBand {
         magnitude_deg: bin as f64 / 10.0,
+        share,
+    })
+}
+
+/// Share of the command's changes at one size from which [`slew_or_dead_time`] says the
+/// records may not tell a slew limit from a dead time: four in five. A zig-zag's first
+/// change, from midships, is half the size of its swings, and a tanker's half-hour record
+/// holds only eight or nine swings; a PRBS of 5–20° puts at most a third of its changes at
+/// one size (the three test worlds).
+const ONE_STEP_SHARE: f64 = 0.8;
+
+/// The caveat for a slew limit or a dead time named on command changes of one size
+/// ([`Caveat::SlewOrDeadTime`]): `named`, the verdict's effect and its second; `est`, the
+/// trials. The size is the commonest |Δδ| between samples to 0.1°, the share is over the
+/// changes (|Δδ| ≥ 0.05°).
+pub(super) fn slew_or_dead_time(named: &[EffectKind], est: &[Record]) -> Option<Caveat> {
+    if !named
+        .iter()
+        .any(|k| matches!(k, EffectKind::RateLimit | EffectKind::DeadTime))
+    {
+        return None;
+    }
+    let mut bins: BTreeMap<i64, usize> = BTreeMap::new();
+    let mut changes = 0usize;
+    for r in est {
+        for w in r.u.windows(2) {
+            let m = ((w[1] - w[0]).abs() * 10.0).round();
+            if m.is_finite() && m > 0.0 {
+                *bins.entry(m as i64).or_default() += 1;
+                changes += 1;
+            }
+        }
+    }
+    let (&bin, &count) = bins.iter().max_by_key(|(b, c)| (**c, -**b))?;
+    let share = count as f64 / changes as f64;
+    (share >= ONE_STEP_SHARE).then_some(Caveat::SlewOrDeadTime {
+        step_deg: bin as f64 / 10.0,
         share,
     })
 }
@@ -130,6 +167,46 @@ mod tests {
                 share: 0.9
             }
         );
+        // a slew limit and a dead time: the zig-zag changes by 20° once (from midships) and
+        // by 40° seven times after
+        let c = slew_or_dead_time(&[EffectKind::RateLimit], &[rec(zz.clone())]).unwrap();
+        assert_eq!(
+            c,
+            Caveat::SlewOrDeadTime {
+                step_deg: 40.0,
+                share: 7.0 / 8.0
+            }
+        );
+        assert!(
+            c.explain().contains("(40.0° in 88 % of the changes)"),
+            "{}",
+            c.explain()
+        );
+        let json = serde_json::to_value(&c).unwrap();
+        assert_eq!(json["caveat"], "slew-or-dead-time");
+        assert_eq!(json["step_deg"], 40.0);
+        let k = [EffectKind::Bias, EffectKind::DeadTime];
+        assert!(slew_or_dead_time(&k, &[rec(zz.clone())]).is_some());
+        assert!(slew_or_dead_time(&[EffectKind::DeadBand], &[rec(zz.clone())]).is_none());
+        // the PRBS changes by 15°, 25° and 35°: none holds four in five
+        assert!(slew_or_dead_time(&[EffectKind::DeadTime], &[rec(prbs.clone())]).is_none());
+        // four changes of 40° and one of 20°: 80 %, the caveat; three and one: 75 %, none
+        let swings = |k: usize| -> Vec<f64> {
+            let mut u = vec![0.0, 20.0];
+            for i in 0..k {
+                u.push(if i % 2 == 0 { -20.0 } else { 20.0 });
+            }
+            u
+        };
+        let c = slew_or_dead_time(&[EffectKind::DeadTime], &[rec(swings(4))]).unwrap();
+        assert_eq!(
+            c,
+            Caveat::SlewOrDeadTime {
+                step_deg: 40.0,
+                share: 0.8
+            }
+        );
+        assert!(slew_or_dead_time(&[EffectKind::DeadTime], &[rec(swings(3))]).is_none());
         // the zig-zag against the PRBS: three quarters of its magnitudes (20°, 290 of 300
         // samples, against a quarter of the PRBS's) lie where the PRBS's do not
         let c = other_manoeuvre(&[rec(zz.clone())], &[rec(prbs.clone())]).unwrap();

@@ -537,6 +537,7 @@ pub fn diagnose(
         .chain(then.as_ref().map(|(e, _)| e.kind))
         .collect();
     caveats.extend(commands::clip_or_dead_band(&named, est));
+    caveats.extend(commands::slew_or_dead_time(&named, est));
     caveats.extend(commands::other_manoeuvre(est, reference));
     let then = then.map(|(e, _)| e.kind.name().to_string());
     if then.as_deref() == Some(EffectKind::Current.name()) {

@@ -532,6 +532,15 @@ pub enum Caveat {
         /// Share of the commanded samples (|δ| > 0) at it.
         share: f64,
     },
+    /// A slew limit or a dead time named (first or second) on trials whose command changes
+    /// hold one size — a zig-zag's 40° swings: a slew limit then delays every change by the
+    /// same time, as a dead time does, and the two differ only in the ramp's shape.
+    SlewOrDeadTime {
+        /// The one size of change (deg).
+        step_deg: f64,
+        /// Share of the command's changes at it.
+        share: f64,
+    },
     /// The trials were sailed with other commands than the reference: half or more of their
     /// command magnitudes lie where the reference's do not (a zig-zag's ±20° against a
     /// PRBS), and a linear model meets the hull's own nonlinearity differently there.
@@ -624,6 +633,15 @@ impl Caveat {
                  which the model approximates. The records cannot tell a saturation from a \
                  dead band; commands of several magnitudes would (a PRBS, or zig-zags of two \
                  amplitudes).",
+                100.0 * share
+            ),
+            Caveat::SlewOrDeadTime { step_deg, share } => format!(
+                "The trials' command changes hold one size ({step_deg:.1}° in {:.0} % of the \
+                 changes): a slew limit takes the same time over every such change, so it \
+                 delays each swing by one time as a dead time does, and the two differ only in \
+                 the shape of the gear's ramp, which a slow hull hardly shows. The records may \
+                 not tell a slew limit from a dead time; changes of several sizes would (a \
+                 PRBS, or zig-zags of two amplitudes).",
                 100.0 * share
             ),
             Caveat::OtherManoeuvre { distance } => format!(
