@@ -1,6 +1,7 @@
 //! What the trials' commands alone say the records cannot tell: an angle limit from a dead
-//! band on commands of one magnitude, a slew limit from a dead time on changes of one size,
-//! and the hull's own nonlinearity on other commands than the reference's.
+//! band, or an asymmetry from a steady moment, on commands of one magnitude; a slew limit
+//! from a dead time on changes of one size; and the hull's own nonlinearity on other
+//! commands than the reference's.
 
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -26,6 +27,34 @@ pub(super) fn clip_or_dead_band(named: &[EffectKind], est: &[Record]) -> Option<
     {
         return None;
     }
+    let (magnitude_deg, share) = one_magnitude(est)?;
+    Some(Caveat::ClipOrDeadBand {
+        magnitude_deg,
+        share,
+    })
+}
+
+/// The caveat for a port/starboard asymmetry or a steady moment named on commands of one
+/// magnitude ([`Caveat::AsymmetryOrBias`]): on ±A an asymmetry β (gain on max(δ, 0)) is a
+/// steady moment of β·A/2 and a rudder effectiveness changed by β/2, and only that change
+/// tells it from a steady moment. Given on the share of [`clip_or_dead_band`].
+pub(super) fn asymmetry_or_bias(named: &[EffectKind], est: &[Record]) -> Option<Caveat> {
+    if !named
+        .iter()
+        .any(|k| matches!(k, EffectKind::Asymmetry | EffectKind::Bias))
+    {
+        return None;
+    }
+    let (magnitude_deg, share) = one_magnitude(est)?;
+    Some(Caveat::AsymmetryOrBias {
+        magnitude_deg,
+        share,
+    })
+}
+
+/// The commonest |δ| of the trials' commanded samples (to 0.1°, commands of 0 not counted)
+/// and its share, when that share is [`ONE_MAGNITUDE_SHARE`] or more.
+fn one_magnitude(est: &[Record]) -> Option<(f64, f64)> {
     let mut bins: BTreeMap<i64, usize> = BTreeMap::new();
     let mut commanded = 0usize;
     for u in est.iter().flat_map(|r| r.u.iter()) {
@@ -37,10 +66,7 @@ pub(super) fn clip_or_dead_band(named: &[EffectKind], est: &[Record]) -> Option<
     }
     let (&bin, &count) = bins.iter().max_by_key(|(b, c)| (**c, -**b))?;
     let share = count as f64 / commanded as f64;
-    (share >= ONE_MAGNITUDE_SHARE).then_some(Caveat::ClipOrDeadBand {
-        magnitude_deg: bin as f64 / 10.0,
-        share,
-    })
+    (share >= ONE_MAGNITUDE_SHARE).then_some((bin as f64 / 10.0, share))
 }
 
 /// Share of the command's changes at one size from which [`slew_or_dead_time`] says the
@@ -167,6 +193,29 @@ mod tests {
                 share: 0.9
             }
         );
+        // an asymmetry and a steady moment on the same commands
+        let c = asymmetry_or_bias(&[EffectKind::Bias], &[rec(zz.clone())]).unwrap();
+        assert_eq!(
+            c,
+            Caveat::AsymmetryOrBias {
+                magnitude_deg: 20.0,
+                share: 1.0
+            }
+        );
+        assert!(
+            c.explain().contains("steady moment of β·20.0°/2"),
+            "{}",
+            c.explain()
+        );
+        assert_eq!(
+            serde_json::to_value(&c).unwrap()["caveat"],
+            "asymmetry-or-bias"
+        );
+        let k = [EffectKind::RateLimit, EffectKind::Asymmetry];
+        assert!(asymmetry_or_bias(&k, &[rec(zz.clone())]).is_some());
+        assert!(asymmetry_or_bias(&[EffectKind::DeadBand], &[rec(zz.clone())]).is_none());
+        assert!(asymmetry_or_bias(&[EffectKind::Bias], &[rec(prbs.clone())]).is_none());
+        assert!(asymmetry_or_bias(&[EffectKind::Bias], &[rec(mix(85))]).is_none());
         // a slew limit and a dead time: the zig-zag changes by 20° once (from midships) and
         // by 40° seven times after
         let c = slew_or_dead_time(&[EffectKind::RateLimit], &[rec(zz.clone())]).unwrap();

@@ -441,7 +441,7 @@ pub fn diagnose(
         })
         .collect();
     yaw_before_speed(&mut ev, &mut gains);
-    let passed_over = gain_before_statistic(&mut ev, &mut gains);
+    let passed_over = gain_before_statistic(&mut ev, &mut gains, &base_before);
     let outpredicted = outpredicted(&mut ev, &mut gains, &base_before, ch.anemometer.is_some());
     bar.inc(1);
     bar.set_message("refit with the verdict's effect");
@@ -537,6 +537,7 @@ pub fn diagnose(
         .chain(then.as_ref().map(|(e, _)| e.kind))
         .collect();
     caveats.extend(commands::clip_or_dead_band(&named, est));
+    caveats.extend(commands::asymmetry_or_bias(&named, est));
     caveats.extend(commands::slew_or_dead_time(&named, est));
     caveats.extend(commands::other_manoeuvre(est, reference));
     let then = then.map(|(e, _)| e.kind.name().to_string());

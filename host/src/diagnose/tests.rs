@@ -84,12 +84,14 @@ fn run_case(f: &Fixture, kind: Option<EffectKind>, strength: f64, seed: u64) -> 
 }
 
 /// The verdict agrees with its evidence: it never names an effect whose held-out gain is
-/// below 0.5 pp while a significant effect gains 1 pp or more.
+/// below 0.5 pp (at 10 steps and in simulation) while a significant effect gains 1 pp or
+/// more (at its own horizon, `fit_gain_pp`).
 fn assert_ranking_rule(d: &Diagnosis) {
     let Some(v) = d.ranking.iter().find(|r| r.effect == d.verdict) else {
         return;
     };
-    if v.fit_gain_pp < 0.5 {
+    let best = v.fit_gain_pp.max(v.fit_gain_10_pp).max(v.fit_gain_sim_pp);
+    if best < 0.5 {
         let better = d
             .ranking
             .iter()
@@ -639,38 +641,6 @@ fn speed_lost_in_turns_is_not_a_current() {
     // up to half the shortest record (a full-scale tanker's surge lag is ≈ 800 s)
     let short: Vec<Record> = trial.iter().map(|r| r.slice(0, 1000)).collect();
     assert_eq!(sog_taus(short.iter()), vec![10.0, 30.0, 90.0, 270.0]);
-}
-
-#[test]
-fn an_offset_without_gain_is_a_note_behind_an_effect_that_improves_prediction() {
-    use super::rule::gain_before_statistic;
-    let fits = BTreeMap::new();
-    let run = |g_first: f64, g_second: f64| {
-        let mut ev = vec![
-            evidence(EffectKind::GyroBias, 1e-9, 0.5, true),
-            evidence(EffectKind::DeadTime, 1e-6, 1e-6, false),
-        ];
-        let mut gains = vec![
-            Some((g_first, fits.clone())),
-            Some((g_second, fits.clone())),
-        ];
-        let passed = gain_before_statistic(&mut ev, &mut gains);
-        let kinds: Vec<EffectKind> = ev.iter().map(|e| e.kind).collect();
-        (passed, kinds, ev[1].words.clone())
-    };
-    // the real-record case: a gyro offset its heading shows, +0.0 pp, ahead of a slow gear
-    // worth +3.5 pp
-    let (passed, kinds, words) = run(0.0, 3.5);
-    assert_eq!(passed, Some(EffectKind::GyroBias));
-    assert_eq!(kinds, [EffectKind::DeadTime, EffectKind::GyroBias]);
-    assert!(words.contains("named behind dead-time"), "{words}");
-    // an offset that improves prediction by 0.5 pp or more keeps its place, and so does
-    // one ahead of an effect worth less than 1 pp
-    for (a, b) in [(0.6, 3.5), (0.0, 0.9)] {
-        let (passed, kinds, _) = run(a, b);
-        assert_eq!(passed, None);
-        assert_eq!(kinds, [EffectKind::GyroBias, EffectKind::DeadTime]);
-    }
 }
 
 #[test]

@@ -532,6 +532,15 @@ pub enum Caveat {
         /// Share of the commanded samples (|δ| > 0) at it.
         share: f64,
     },
+    /// A port/starboard asymmetry or a steady moment named (first or second) on trials whose
+    /// commands hold one magnitude A: there an asymmetry is a steady moment and a changed
+    /// rudder effectiveness, and only that change tells the two apart.
+    AsymmetryOrBias {
+        /// The one magnitude (deg).
+        magnitude_deg: f64,
+        /// Share of the commanded samples (|δ| > 0) at it.
+        share: f64,
+    },
     /// A slew limit or a dead time named (first or second) on trials whose command changes
     /// hold one size — a zig-zag's 40° swings: a slew limit then delays every change by the
     /// same time, as a dead time does, and the two differ only in the ramp's shape.
@@ -635,6 +644,18 @@ impl Caveat {
                  amplitudes).",
                 100.0 * share
             ),
+            Caveat::AsymmetryOrBias {
+                magnitude_deg,
+                share,
+            } => format!(
+                "The trials' commands hold one magnitude (±{magnitude_deg:.1}° in {:.0} % of \
+                 the commanded samples): there a port/starboard asymmetry β (a gain on \
+                 max(δ, 0)) is a steady moment of β·{magnitude_deg:.1}°/2 and a rudder \
+                 effectiveness changed by β/2, and only that change, which the hull's own \
+                 nonlinearity also makes, tells it from a steady moment. The records may not \
+                 tell an asymmetry from a steady moment; commands of several magnitudes would.",
+                100.0 * share
+            ),
             Caveat::SlewOrDeadTime { step_deg, share } => format!(
                 "The trials' command changes hold one size ({step_deg:.1}° in {:.0} % of the \
                  changes): a slew limit takes the same time over every such change, so it \
@@ -658,7 +679,8 @@ impl Caveat {
                 format!(
                     "Note: {} ({effect}) is significant but does not improve held-out \
                      prediction; by the ranking rule no effect that does not improve prediction \
-                     (< {NO_GAIN_PP} pp) is named ahead of one that does (≥ {GAIN_PP} pp).",
+                     (< {NO_GAIN_PP} pp at 10 steps and in simulation) is named ahead of one \
+                     that does (≥ {GAIN_PP} pp at its own horizon).",
                     kind.map_or("an effect", effect_phrase)
                 )
             }
