@@ -21,13 +21,8 @@ const ONE_MAGNITUDE_SHARE: f64 = 0.9;
 /// trials. The magnitude is the commonest |δ| to 0.1°, the share is over the samples whose
 /// command is not 0.
 pub(super) fn clip_or_dead_band(named: &[EffectKind], est: &[Record]) -> Option<Caveat> {
-    if !named
-        .iter()
-        .any(|k| matches!(k, EffectKind::Saturation | EffectKind::DeadBand))
-    {
-        return None;
-    }
-    let (magnitude_deg, share) = one_magnitude(est)?;
+    let (magnitude_deg, share) =
+        names_one_magnitude(named, EffectKind::Saturation, EffectKind::DeadBand, est)?;
     Some(Caveat::ClipOrDeadBand {
         magnitude_deg,
         share,
@@ -39,34 +34,43 @@ pub(super) fn clip_or_dead_band(named: &[EffectKind], est: &[Record]) -> Option<
 /// steady moment of β·A/2 and a rudder effectiveness changed by β/2, and only that change
 /// tells it from a steady moment. Given on the share of [`clip_or_dead_band`].
 pub(super) fn asymmetry_or_bias(named: &[EffectKind], est: &[Record]) -> Option<Caveat> {
-    if !named
-        .iter()
-        .any(|k| matches!(k, EffectKind::Asymmetry | EffectKind::Bias))
-    {
-        return None;
-    }
-    let (magnitude_deg, share) = one_magnitude(est)?;
+    let (magnitude_deg, share) =
+        names_one_magnitude(named, EffectKind::Asymmetry, EffectKind::Bias, est)?;
     Some(Caveat::AsymmetryOrBias {
         magnitude_deg,
         share,
     })
 }
 
-/// The commonest |δ| of the trials' commanded samples (to 0.1°, commands of 0 not counted)
-/// and its share, when that share is [`ONE_MAGNITUDE_SHARE`] or more.
-fn one_magnitude(est: &[Record]) -> Option<(f64, f64)> {
+/// When `a` or `b` is among `named`: the commonest |δ| of the trials' commanded samples and
+/// its share ([`commonest`]), when that share is [`ONE_MAGNITUDE_SHARE`] or more.
+fn names_one_magnitude(
+    named: &[EffectKind],
+    a: EffectKind,
+    b: EffectKind,
+    est: &[Record],
+) -> Option<(f64, f64)> {
+    if !named.iter().any(|k| *k == a || *k == b) {
+        return None;
+    }
+    commonest(est.iter().flat_map(|r| r.u.iter().copied()))
+        .filter(|(_, share)| *share >= ONE_MAGNITUDE_SHARE)
+}
+
+/// The commonest |v| to 0.1° among `values` (those that round to 0, and non-finite ones,
+/// not counted) and its share of the counted.
+fn commonest(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
     let mut bins: BTreeMap<i64, usize> = BTreeMap::new();
-    let mut commanded = 0usize;
-    for u in est.iter().flat_map(|r| r.u.iter()) {
-        let m = (u.abs() * 10.0).round();
+    let mut counted = 0usize;
+    for v in values {
+        let m = (v.abs() * 10.0).round();
         if m.is_finite() && m > 0.0 {
             *bins.entry(m as i64).or_default() += 1;
-            commanded += 1;
+            counted += 1;
         }
     }
     let (&bin, &count) = bins.iter().max_by_key(|(b, c)| (**c, -**b))?;
-    let share = count as f64 / commanded as f64;
-    (share >= ONE_MAGNITUDE_SHARE).then_some((bin as f64 / 10.0, share))
+    Some((bin as f64 / 10.0, count as f64 / counted as f64))
 }
 
 /// Share of the command's changes at one size from which [`slew_or_dead_time`] says the
@@ -87,23 +91,9 @@ pub(super) fn slew_or_dead_time(named: &[EffectKind], est: &[Record]) -> Option<
     {
         return None;
     }
-    let mut bins: BTreeMap<i64, usize> = BTreeMap::new();
-    let mut changes = 0usize;
-    for r in est {
-        for w in r.u.windows(2) {
-            let m = ((w[1] - w[0]).abs() * 10.0).round();
-            if m.is_finite() && m > 0.0 {
-                *bins.entry(m as i64).or_default() += 1;
-                changes += 1;
-            }
-        }
-    }
-    let (&bin, &count) = bins.iter().max_by_key(|(b, c)| (**c, -**b))?;
-    let share = count as f64 / changes as f64;
-    (share >= ONE_STEP_SHARE).then_some(Caveat::SlewOrDeadTime {
-        step_deg: bin as f64 / 10.0,
-        share,
-    })
+    let changes = est.iter().flat_map(|r| r.u.windows(2).map(|w| w[1] - w[0]));
+    let (step_deg, share) = commonest(changes).filter(|(_, share)| *share >= ONE_STEP_SHARE)?;
+    Some(Caveat::SlewOrDeadTime { step_deg, share })
 }
 
 /// Distance between the trials' and the reference's commands from which [`other_manoeuvre`]
