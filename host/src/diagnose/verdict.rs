@@ -401,6 +401,15 @@ pub(super) fn ranked(
     (ranking, verdict)
 }
 
+/// An effect's held-out gains in words: at its own horizon (`fit_gain_pp`), then at the two
+/// horizons the ranking rule reads, as the evidence table prints them.
+fn gains_words(r: &Ranked) -> String {
+    format!(
+        "{:+.1} pp (10 steps {:+.1}, simulation {:+.1})",
+        r.fit_gain_pp, r.fit_gain_10_pp, r.fit_gain_sim_pp
+    )
+}
+
 /// The verdict in words: the verdict's name, the explanation's opening sentences, the
 /// held-out fits after, and the confirming refit (`verdict`: the index of the verdict's
 /// effect in `ev` and `ranking`, its held-out fits and refit).
@@ -417,12 +426,12 @@ pub(super) fn verdict_words(
             let e = &ev[i];
             let r = &ranking[i];
             let mut s = format!(
-                "The trials show {} that the {} lacks: {} (p {}, held-out fit gain {:+.1} pp).",
+                "The trials show {} that the {} lacks: {} (p {}, held-out fit gain {}).",
                 effect_phrase(e.kind),
                 if has_ref { "reference" } else { "model" },
                 e.words,
                 fmt_p(r.p_value),
-                r.fit_gain_pp
+                gains_words(r)
             );
             if let Some((_, second)) = ranking
                 .iter()
@@ -431,12 +440,12 @@ pub(super) fn verdict_words(
             {
                 s.push_str(&format!(
                     " Runner-up: {} (p {}, likelihood gain above noise {:.0} against {:.0}, \
-                     held-out fit gain {:+.1} pp).",
+                     held-out fit gain {}).",
                     second.effect,
                     fmt_p(second.p_value),
                     second.above_noise,
                     r.above_noise,
-                    second.fit_gain_pp
+                    gains_words(second)
                 ));
                 if second.p_value < r.p_value {
                     s.push_str(
@@ -837,5 +846,26 @@ mod tests {
         // gains have no grid
         assert_eq!(grid_gap(0.2, &[Effect::GyroBias { d_y: 0.0 }], 0.5), None);
         assert_eq!(grid_gap(1.0, &[dead(2)], 0.5), None);
+    }
+
+    #[test]
+    fn the_verdict_words_its_gains_at_both_horizons() {
+        // KVLCC2's half-strength asymmetry on zig-zags: little at 10 steps, much in
+        // simulation — the sentence shows what the ranking rule reads
+        let r = Ranked {
+            effect: "asymmetry".into(),
+            statistic: 173.8,
+            p_value: 3e-30,
+            above_noise: 172.0,
+            fit_gain_pp: 0.23,
+            fit_gain_10_pp: 0.23,
+            fit_gain_sim_pp: 5.53,
+            significant: true,
+            material: true,
+            parameter: Some(0.151),
+            parameter_uncertainty: None,
+            evidence: String::new(),
+        };
+        assert_eq!(gains_words(&r), "+0.2 pp (10 steps +0.2, simulation +5.5)");
     }
 }
