@@ -196,11 +196,15 @@ for w in "${world_list[@]}"; do
     mapfile -t sim < <(world_args "$w")
     # a reference is reused only when it was sailed with the same options (a work directory
     # of another run, without the anemometer say, would otherwise serve a stale one)
-    stamp="${sim[*]} --records 3 --seed 900 --input $refinput --gyro-noise 0.02 --heading-noise 0.1 $logwind"
-    if [ ! -f "$work/$w/ref.postcard" ] || [ "$(cat "$work/$w/ref.args" 2>/dev/null)" != "$stamp" ]; then
+    # shellcheck disable=SC2206 # $logwind: one word or none
+    refopts=(--records 3 --seed 900 --input "$refinput" --gyro-noise 0.02 --heading-noise 0.1
+        $logwind)
+    stamp="${sim[*]} ${refopts[*]}"
+    if [ ! -f "$work/$w/ref.postcard" ] \
+        || [ "$(cat "$work/$w/ref.args" 2>/dev/null)" != "$stamp" ]; then
         rm -f "$work/$w/ref.postcard"
-        "$yawcast" simulate "${sim[@]}" --records 3 --seed 900 --input "$refinput" --gyro-noise 0.02 \
-            --heading-noise 0.1 $logwind --out "$work/$w/ref.csv" >"$work/$w/ref.log" 2>&1
+        "$yawcast" simulate "${sim[@]}" "${refopts[@]}" --out "$work/$w/ref.csv" \
+            >"$work/$w/ref.log" 2>&1
         "$yawcast" identify --data "$work/$w/ref-1.csv" --data "$work/$w/ref-2.csv" \
             --data "$work/$w/ref-3.csv" --out "$work/$w/ref" >>"$work/$w/ref.log" 2>&1
         printf '%s\n' "$stamp" >"$work/$w/ref.args"
