@@ -207,12 +207,12 @@ const CROSS_MIN_SPEED: f64 = 0.1;
 /// ([`turned`]) per record, and the lane's own regressors (see [`Lane`]).
 /// `shift[i]` circularly shifts record i's heading against its speed (0: aligned);
 /// `remove` is a heading dependence (coefficients as returned) taken out of the target at the
-/// true heading first, as the null draws do. `harm[i]` are record i's [`heading_harmonics`]
+/// true heading first, as the null draws do. `heading[i]` is record i's [`Heading`]
 /// (computed once for the many shifted draws of one set).
 fn sog_harmonics(
     lane: Lane,
     recs: &[&Record],
-    harm: &[Vec<[f64; 4]>],
+    heading: &[Heading],
     shift: &[usize],
     taus: &[f64],
     remove: Option<&DVector<f64>>,
@@ -232,7 +232,7 @@ fn sog_harmonics(
     let mut xty = DVector::<f64>::zeros(p);
     let mut x = DVector::<f64>::zeros(p);
     let mut rows = 0usize;
-    for ((i, r), hr) in recs.iter().enumerate().zip(harm) {
+    for ((i, r), hd) in recs.iter().enumerate().zip(heading) {
         let psi = r.psi.as_ref()?;
         let sp = r.speed.as_ref()?;
         let cog = match lane {
@@ -243,7 +243,7 @@ fn sog_harmonics(
         let mut lr = vec![0.0; nt];
         let mut lu = vec![0.0; nt];
         let n = r.len();
-        let turn = turned(psi);
+        let (hr, turn) = (&hd.harmonics, &hd.turned);
         let sh = shift.get(i).copied().unwrap_or(0) % n.max(1);
         for t in 0..n {
             let (fr, fu) = match lane {
@@ -331,20 +331,28 @@ fn turned(psi: &[f64]) -> Vec<f64> {
     out
 }
 
-/// The heading harmonics (sin ψ, cos ψ, sin 2ψ, cos 2ψ) of every sample of every record;
-/// `None` when a record has no heading.
-fn heading_harmonics(recs: &[&Record]) -> Option<Vec<Vec<[f64; 4]>>> {
+/// A record's heading as the ground track's regression reads it, per sample: its harmonics
+/// (sin ψ, cos ψ, sin 2ψ, cos 2ψ) and the heading turned through ([`turned`]).
+struct Heading {
+    harmonics: Vec<[f64; 4]>,
+    turned: Vec<f64>,
+}
+
+/// The [`Heading`] of every record; `None` when a record has no heading.
+fn headings(recs: &[&Record]) -> Option<Vec<Heading>> {
     recs.iter()
         .map(|r| {
             let psi = r.psi.as_ref()?;
-            Some(
-                psi.iter()
+            Some(Heading {
+                harmonics: psi
+                    .iter()
                     .map(|p| {
                         let ph = p.to_radians();
                         [ph.sin(), ph.cos(), (2.0 * ph).sin(), (2.0 * ph).cos()]
                     })
                     .collect(),
-            )
+                turned: turned(psi),
+            })
         })
         .collect()
 }
@@ -390,7 +398,7 @@ const SOG_SHIFTS: usize = 60;
 fn sog_null_cov(
     lane: Lane,
     recs: &[&Record],
-    harm: &[Vec<[f64; 4]>],
+    heading: &[Heading],
     taus: &[f64],
     own: &DVector<f64>,
     rng: &mut ChaCha8Rng,
@@ -404,7 +412,7 @@ fn sog_null_cov(
                 rng.random_range(n / 10..=(9 * n / 10).max(n / 10 + 1))
             })
             .collect();
-        draws.push(sog_harmonics(lane, recs, harm, &sh, taus, Some(own))?);
+        draws.push(sog_harmonics(lane, recs, heading, &sh, taus, Some(own))?);
     }
     let m = draws.len() as f64;
     let mean = draws.iter().fold(DVector::zeros(4), |a, b| a + b) / m;
@@ -567,13 +575,13 @@ fn sog_difference(
     taus: &[f64],
     rng: &mut ChaCha8Rng,
 ) -> Option<(DVector<f64>, DMatrix<f64>)> {
-    let ht = heading_harmonics(trial)?;
+    let ht = headings(trial)?;
     let t = sog_harmonics(lane, trial, &ht, &[], taus, None)?;
     let vt = sog_null_cov(lane, trial, &ht, taus, &t, rng)?;
     if reference.is_empty() {
         return Some((t, vt));
     }
-    let hr = heading_harmonics(reference)?;
+    let hr = headings(reference)?;
     let r = sog_harmonics(lane, reference, &hr, &[], taus, None)?;
     let vr = sog_null_cov(lane, reference, &hr, taus, &r, rng)?;
     Some((t - r, vt + vr))
