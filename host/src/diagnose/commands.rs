@@ -57,20 +57,30 @@ fn names_one_magnitude(
         .filter(|(_, share)| *share >= ONE_MAGNITUDE_SHARE)
 }
 
+/// Relative width within which magnitudes (or changes) count as one: 5 %. A logged rudder
+/// angle differs by a few tenths of a degree between the two sides of a zig-zag (the Esso
+/// Osaka model's ±20°: 19.5° to starboard, 20.2° to port), where a PRBS's magnitudes lie
+/// 5° or more apart.
+const SAME_WITHIN: f64 = 0.05;
+
 /// The commonest |v| to 0.1° among `values` (those that round to 0, and non-finite ones,
-/// not counted) and its share of the counted.
+/// not counted) and the share of the counted within [`SAME_WITHIN`] of it.
 fn commonest(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
+    let counted: Vec<f64> = values
+        .map(f64::abs)
+        .filter(|m| m.is_finite() && (m * 10.0).round() > 0.0)
+        .collect();
     let mut bins: BTreeMap<i64, usize> = BTreeMap::new();
-    let mut counted = 0usize;
-    for v in values {
-        let m = (v.abs() * 10.0).round();
-        if m.is_finite() && m > 0.0 {
-            *bins.entry(m as i64).or_default() += 1;
-            counted += 1;
-        }
+    for m in &counted {
+        *bins.entry((m * 10.0).round() as i64).or_default() += 1;
     }
-    let (&bin, &count) = bins.iter().max_by_key(|(b, c)| (**c, -**b))?;
-    Some((bin as f64 / 10.0, count as f64 / counted as f64))
+    let (&bin, _) = bins.iter().max_by_key(|(b, c)| (**c, -**b))?;
+    let centre = bin as f64 / 10.0;
+    let within = counted
+        .iter()
+        .filter(|m| (*m - centre).abs() <= SAME_WITHIN * centre)
+        .count();
+    Some((centre, within as f64 / counted.len() as f64))
 }
 
 /// Share of the command's changes at one size from which [`slew_or_dead_time`] says the
@@ -82,8 +92,9 @@ const ONE_STEP_SHARE: f64 = 0.8;
 
 /// The caveat for a slew limit or a dead time named on command changes of one size
 /// ([`Caveat::SlewOrDeadTime`]): `named`, the verdict's effect and its second; `est`, the
-/// trials. The size is the commonest |Δδ| between samples to 0.1°, the share is over the
-/// changes (|Δδ| ≥ 0.05°).
+/// trials. The size is the commonest |Δδ| between samples ([`commonest`]); the changes
+/// counted are those of a tenth of the largest or more — a logged angle's jitter of a
+/// degree between a zig-zag's 40° swings is not a command.
 pub(super) fn slew_or_dead_time(named: &[EffectKind], est: &[Record]) -> Option<Caveat> {
     if !named
         .iter()
@@ -91,8 +102,14 @@ pub(super) fn slew_or_dead_time(named: &[EffectKind], est: &[Record]) -> Option<
     {
         return None;
     }
-    let changes = est.iter().flat_map(|r| r.u.windows(2).map(|w| w[1] - w[0]));
-    let (step_deg, share) = commonest(changes).filter(|(_, share)| *share >= ONE_STEP_SHARE)?;
+    let changes: Vec<f64> = est
+        .iter()
+        .flat_map(|r| r.u.windows(2).map(|w| (w[1] - w[0]).abs()))
+        .filter(|d| d.is_finite())
+        .collect();
+    let largest = changes.iter().copied().fold(0.0, f64::max);
+    let commands = changes.into_iter().filter(|d| *d >= 0.1 * largest);
+    let (step_deg, share) = commonest(commands).filter(|(_, share)| *share >= ONE_STEP_SHARE)?;
     Some(Caveat::SlewOrDeadTime { step_deg, share })
 }
 
@@ -246,6 +263,28 @@ mod tests {
             }
         );
         assert!(slew_or_dead_time(&[EffectKind::DeadTime], &[rec(swings(3))]).is_none());
+        // a logged angle (the Esso Osaka model's ±20° zig-zag): 19.5° to one side, 20.2° to
+        // the other, a degree of jitter between the 40° swings — one magnitude, one size
+        let logged: Vec<f64> = (0..200)
+            .map(|i| {
+                let side = if (i / 25) % 2 == 0 { 19.5 } else { -20.2 };
+                side + if i % 5 == 0 { 0.6 } else { 0.0 }
+            })
+            .collect();
+        let c = clip_or_dead_band(&[EffectKind::DeadBand], &[rec(logged.clone())]).unwrap();
+        let Caveat::ClipOrDeadBand {
+            magnitude_deg,
+            share,
+        } = c
+        else {
+            panic!("{c:?}")
+        };
+        assert_eq!((magnitude_deg, share), (19.5, 1.0));
+        let c = slew_or_dead_time(&[EffectKind::DeadTime], &[rec(logged)]).unwrap();
+        let Caveat::SlewOrDeadTime { step_deg, share } = c else {
+            panic!("{c:?}")
+        };
+        assert!(step_deg > 39.0 && share == 1.0, "{c:?}");
         // the zig-zag against the PRBS: three quarters of its magnitudes (20°, 290 of 300
         // samples, against a quarter of the PRBS's) lie where the PRBS's do not
         let c = other_manoeuvre(&[rec(zz.clone())], &[rec(prbs.clone())]).unwrap();

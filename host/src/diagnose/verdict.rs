@@ -538,7 +538,7 @@ pub enum Caveat {
     ClipOrDeadBand {
         /// The one magnitude (deg).
         magnitude_deg: f64,
-        /// Share of the commanded samples (|δ| > 0) at it.
+        /// Share of the commanded samples (|δ| > 0) within 5 % of it.
         share: f64,
     },
     /// A port/starboard asymmetry or a steady moment named (first or second) on trials whose
@@ -547,7 +547,7 @@ pub enum Caveat {
     AsymmetryOrBias {
         /// The one magnitude (deg).
         magnitude_deg: f64,
-        /// Share of the commanded samples (|δ| > 0) at it.
+        /// Share of the commanded samples (|δ| > 0) within 5 % of it.
         share: f64,
     },
     /// A slew limit or a dead time named (first or second) on trials whose command changes
@@ -556,7 +556,8 @@ pub enum Caveat {
     SlewOrDeadTime {
         /// The one size of change (deg).
         step_deg: f64,
-        /// Share of the command's changes at it.
+        /// Share of the command's changes (those of a tenth of the largest or more) within
+        /// 5 % of it.
         share: f64,
     },
     /// The trials were sailed with other commands than the reference: half or more of their
