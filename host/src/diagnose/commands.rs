@@ -281,6 +281,28 @@ mod tests {
             panic!("{c:?}")
         };
         assert!(step_deg > 39.0 && share == 1.0, "{c:?}");
+        // the measured zig-zag itself (tests/data/real): the Esso Osaka model's second ±20°
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../tests/data/real/esso_osaka/zz20_n12_b.csv");
+        let esso = crate::io::data::read_csv(&path).unwrap();
+        let c = clip_or_dead_band(&[EffectKind::Saturation], std::slice::from_ref(&esso));
+        let Some(Caveat::ClipOrDeadBand {
+            magnitude_deg,
+            share,
+        }) = c
+        else {
+            panic!("{c:?}")
+        };
+        assert_eq!(magnitude_deg, 19.5);
+        assert!(share > 0.95, "{share}");
+        let c = slew_or_dead_time(&[EffectKind::DeadTime], std::slice::from_ref(&esso));
+        assert_eq!(
+            c,
+            Some(Caveat::SlewOrDeadTime {
+                step_deg: 39.7,
+                share: 0.6
+            })
+        );
         // the zig-zag against the PRBS: three quarters of its magnitudes (20°, 290 of 300
         // samples, against a quarter of the PRBS's) lie where the PRBS's do not
         let c = other_manoeuvre(&[rec(zz.clone())], &[rec(prbs.clone())]).unwrap();
