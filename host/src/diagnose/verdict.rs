@@ -20,8 +20,20 @@ use crate::identify::predict::Horizon;
 use crate::io::data::Record;
 
 /// Number of effects tested (Bonferroni: each is judged at α / m).
+const TESTED: usize = EffectKind::ALL.len();
+
+/// Number of effects tested, as a divisor of α ([`TESTED`]).
 pub(super) fn cfg_m(_cfg: &DiagnoseConfig) -> f64 {
-    EffectKind::ALL.len() as f64
+    TESTED as f64
+}
+
+/// The level applied, in words: α and the level each effect is judged at, α/m.
+fn level_words(alpha: f64) -> String {
+    format!(
+        "each of the {TESTED} library effects is judged at α/{TESTED} = {}, with α = {alpha} \
+         and Bonferroni over the effects tested",
+        alpha / TESTED as f64
+    )
 }
 
 /// Everything computed for one effect kind.
@@ -405,7 +417,7 @@ pub(super) fn ranked(
 /// horizons the ranking rule reads, as the evidence table prints them.
 fn gains_words(r: &Ranked) -> String {
     format!(
-        "{:+.1} pp (10 steps {:+.1}, simulation {:+.1})",
+        "{:+.1} pp at its own horizon, {:+.1} at 10 steps, {:+.1} in simulation",
         r.fit_gain_pp, r.fit_gain_10_pp, r.fit_gain_sim_pp
     )
 }
@@ -456,6 +468,7 @@ pub(super) fn verdict_words(
                     );
                 }
             }
+            s.push_str(&format!(" Significance: {}.", level_words(alpha)));
             if let Some(a) = &aug {
                 s.push_str(&format!(" Refitted with the model: {}", a.explanation));
             }
@@ -465,20 +478,21 @@ pub(super) fn verdict_words(
             let sig: Vec<&Ranked> = ranking.iter().filter(|r| r.significant).collect();
             let s = if sig.is_empty() {
                 format!(
-                    "No effect of the library is significant at α = {} against its null \
-                     distribution: the trials show nothing the {} lacks.",
-                    alpha,
+                    "No effect of the library is significant against its null distribution \
+                     ({}): the trials show nothing the {} lacks.",
+                    level_words(alpha),
                     if has_ref { "reference" } else { "model" }
                 )
             } else {
                 format!(
                     "{} significant but not material: refitted, {} not improve held-out \
-                     prediction, so the model is kept without it.",
+                     prediction, so the model is kept without it. Significance: {}.",
                     sig.iter()
                         .map(|r| r.effect.as_str())
                         .collect::<Vec<_>>()
                         .join(", "),
-                    if sig.len() == 1 { "it does" } else { "they do" }
+                    if sig.len() == 1 { "it does" } else { "they do" },
+                    level_words(alpha)
                 )
             };
             ("none".to_string(), s, before.clone(), None)
@@ -867,6 +881,21 @@ mod tests {
             parameter_uncertainty: None,
             evidence: String::new(),
         };
-        assert_eq!(gains_words(&r), "+0.2 pp (10 steps +0.2, simulation +5.5)");
+        assert_eq!(
+            gains_words(&r),
+            "+0.2 pp at its own horizon, +0.2 at 10 steps, +5.5 in simulation"
+        );
+    }
+
+    #[test]
+    fn the_level_applied_is_the_level_printed() {
+        // α = 0.01 over the library's ten effects: 0.001 each, as `cfg_m` divides
+        let w = level_words(0.01);
+        assert_eq!(
+            w,
+            "each of the 10 library effects is judged at α/10 = 0.001, with α = 0.01 and \
+             Bonferroni over the effects tested"
+        );
+        assert_eq!(cfg_m(&DiagnoseConfig::default()), 10.0);
     }
 }
