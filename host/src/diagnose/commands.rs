@@ -7,7 +7,7 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use yawcast_shared::model::EffectKind;
 
-use super::verdict::Caveat;
+use super::caveat::Caveat;
 use crate::io::data::Record;
 
 /// Share of the commanded samples at one magnitude from which [`clip_or_dead_band`] says

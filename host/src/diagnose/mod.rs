@@ -86,6 +86,7 @@
 //! the trials, the reference's version (the model's own) against the trials' best.
 
 pub mod augment;
+mod caveat;
 mod channels;
 mod commands;
 pub mod compare;
@@ -113,17 +114,17 @@ use crate::identify::model::{Effect, Model};
 use crate::identify::pem::offset::OFFSET_KINDS;
 use crate::identify::predict::Horizon;
 use crate::io::data::Record;
+use caveat::caveats;
 use channels::Channels;
 use evidence::{grid, reference_versions, trial_stats, Set};
 use null::bootstrap;
 use reference::{foreign, reference_actuator};
 use rule::{gain_before_statistic, outpredicted, yaw_before_speed};
-use verdict::{
-    caveats, cfg_m, effect_evidence, frozen_gain, rank, ranked, split, verdict_words, Evidence,
-};
+use verdict::{cfg_m, effect_evidence, frozen_gain, rank, ranked, split, verdict_words, Evidence};
 
 pub use crate::io::data::{heading_bias, HeadingBias};
-pub use verdict::{effect_phrase, Caveat};
+pub use caveat::Caveat;
+pub use verdict::effect_phrase;
 pub use window::{window, WINDOW, WINDOW_BLOCK};
 
 /// Horizon (samples) of the prediction errors the slow effects are fitted on.
@@ -528,7 +529,7 @@ pub fn diagnose(
         ));
     }
     let verdict_ev = ev.iter().find(|e| e.kind.name() == verdict_name);
-    caveats.extend(verdict::current_or_leeway(
+    caveats.extend(caveat::current_or_leeway(
         verdict_ev.into_iter().chain(then.as_ref().map(|(e, _)| e)),
     ));
     let named: Vec<EffectKind> = verdict_ev

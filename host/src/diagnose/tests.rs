@@ -6,10 +6,11 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
+use super::caveat::current_or_leeway;
 use super::channels::{sog_evidence, sog_evidence_with, sog_taus};
 use super::evidence::{trial_statistic, Version};
 use super::null::{simulate_innovations, Null};
-use super::verdict::{current_or_leeway, current_or_wind};
+use super::verdict::current_or_wind;
 use super::*;
 use crate::identify::pem::{self, PemConfig};
 use crate::sim::{simulate, NoiseSpec, Scenario, Ship, SimEffect};

@@ -1,0 +1,291 @@
+//! Caveats: what the verdict rests on that weakens or qualifies it, and their words.
+
+use serde::Serialize;
+use yawcast_shared::model::EffectKind;
+
+use super::channels::Channels;
+use super::rule::{GAIN_PP, NO_GAIN_PP};
+use super::verdict::{effect_phrase, fmt_p, Evidence};
+use super::{WINDOW, WINDOW_BLOCK};
+use crate::io::data::Record;
+
+/// What the verdict rests on that weakens or qualifies it; [`Caveat::explain`] says it in
+/// words (the explanation appends them in this order).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "caveat", rename_all = "kebab-case")]
+pub enum Caveat {
+    /// The reference records show steering-gear dynamics of their own; the statistics were
+    /// measured against the reference model with them.
+    ReferenceGear {
+        /// The sentence naming the gear and its held-out fits.
+        words: String,
+    },
+    /// Long sets were diagnosed on blocks spread evenly over them.
+    Blocks {
+        /// Blocks of the trials (0: used whole).
+        trials: usize,
+        /// Of the reference.
+        reference: usize,
+        /// Of the held-out records.
+        held_out: usize,
+    },
+    /// No reference records: every statistic is judged against the model alone.
+    NoReference,
+    /// The model does not look identified from the reference records.
+    ForeignModel {
+        /// Its one-step error on the reference above the re-identified structure's (%).
+        excess_pct: f64,
+    },
+    /// Heading is not logged in every record.
+    NoHeading,
+    /// Speed over ground (or heading) is not logged in every record.
+    NoSpeedOverGround,
+    /// Speed over ground cannot show a current weaker than `smallest_mps` on these records
+    /// (heading range, speed lost in turns): a verdict other than current does not rule
+    /// one out (not given when a current is named, first or second).
+    CurrentResolution {
+        /// The smallest current (m/s) the records show at the level applied, in any
+        /// direction.
+        smallest_mps: f64,
+    },
+    /// A current named from speed over ground alone, with no anemometer: the wind's leeway
+    /// sets the ship over ground as a current does, and the yaw channel, which decides
+    /// between the two without an anemometer, shows no heading-dependent moment.
+    CurrentOrLeeway {
+        /// p-value of the yaw channel's heading-dependent moment (absent: ≥ α).
+        p_moment: f64,
+    },
+    /// An angle limit or a dead band named (first or second) on trials whose commands hold
+    /// one magnitude — a zig-zag's ±20°: a limit below it and a dead band take the same off
+    /// every command, and the records cannot tell them apart.
+    ClipOrDeadBand {
+        /// The one magnitude (deg).
+        magnitude_deg: f64,
+        /// Share of the commanded samples (|δ| > 0) within 5 % of it.
+        share: f64,
+    },
+    /// A port/starboard asymmetry or a steady moment named (first or second) on trials whose
+    /// commands hold one magnitude A: there an asymmetry is a steady moment and a changed
+    /// rudder effectiveness, and only that change tells the two apart.
+    AsymmetryOrBias {
+        /// The one magnitude (deg).
+        magnitude_deg: f64,
+        /// Share of the commanded samples (|δ| > 0) within 5 % of it.
+        share: f64,
+    },
+    /// A slew limit or a dead time named (first or second) on trials whose command changes
+    /// hold one size — a zig-zag's 40° swings: a slew limit then delays every change by the
+    /// same time, as a dead time does, and the two differ only in the ramp's shape.
+    SlewOrDeadTime {
+        /// The one size of change (deg).
+        step_deg: f64,
+        /// Share of the command's changes (those of a tenth of the largest or more) within
+        /// 5 % of it.
+        share: f64,
+    },
+    /// The trials were sailed with other commands than the reference: half or more of their
+    /// command magnitudes lie where the reference's do not (a zig-zag's ±20° against a
+    /// PRBS), and a linear model meets the hull's own nonlinearity differently there.
+    OtherManoeuvre {
+        /// Total-variation distance between the two sets' distributions of |δ| in 1° bins
+        /// (0: alike, 1: disjoint).
+        distance: f64,
+    },
+    /// A significant effect that does not improve held-out prediction was named behind
+    /// the verdict by the ranking rule.
+    PassedOver {
+        /// Its name.
+        effect: String,
+    },
+    /// An effect with the larger likelihood statistic was named behind one that predicts the
+    /// held-out records better both at 10 steps and in simulation (the ranking rule's second
+    /// clause).
+    Outpredicted {
+        /// Its name.
+        effect: String,
+        /// Its held-out gains (pp) at 10 steps and in simulation.
+        gains_pp: [f64; 2],
+        /// The effect named ahead of it.
+        by: String,
+        /// That effect's held-out gains (pp) at 10 steps and in simulation.
+        by_gains_pp: [f64; 2],
+    },
+}
+
+impl Caveat {
+    /// The caveat in words, as the explanation appends it.
+    ///
+    /// ```
+    /// use yawcast::diagnose::Caveat;
+    /// assert!(Caveat::NoReference.explain().starts_with("No reference records were given"));
+    /// ```
+    pub fn explain(&self) -> String {
+        match self {
+            Caveat::ReferenceGear { words } => words.trim().to_string(),
+            Caveat::Blocks {
+                trials,
+                reference,
+                held_out,
+            } => format!(
+                "Records of more than {WINDOW} samples per set are diagnosed on blocks of up to \
+                 {WINDOW_BLOCK} samples spread evenly over them ({trials} of the trials, \
+                 {reference} of the reference, {held_out} of the held-out records; 0: used whole)."
+            ),
+            Caveat::NoReference => "No reference records were given, so every statistic is \
+                judged against the model alone: hull nonlinearity the model never had shows up \
+                as an effect, and the verdict is weaker."
+                .into(),
+            Caveat::ForeignModel { excess_pct } => format!(
+                "The model does not look identified from the reference records: its one-step \
+                 error there is {excess_pct:.0} % above that of the same structure re-identified \
+                 on them, and it predicts the trials better than that model does. A model \
+                 identified or tuned on the trials has absorbed part of what they show (an \
+                 actuator limit above all), so the evidence is weaker; the strongest test uses \
+                 the model identified on the reference records."
+            ),
+            Caveat::NoHeading => "Heading is not logged in every record: a gyro bias cannot be \
+                told apart from a constant yaw moment (bias), and wind and current are tested on \
+                the heading integrated from the measured yaw rate, from an unknown start (0°) \
+                and drifting with any rate offset."
+                .into(),
+            Caveat::NoSpeedOverGround => "Speed over ground (or heading) is not logged in every \
+                record: current and wind are judged from the yaw rate alone and are hard to tell \
+                apart from a bias."
+                .into(),
+            Caveat::CurrentResolution { smallest_mps } => format!(
+                "Speed over ground on these records shows a current only from about \
+                 {smallest_mps:.2} m/s on (in any direction, at the level applied: the headings \
+                 sailed and the speed lost in turns limit it); a weaker current cannot be told."
+            ),
+            Caveat::CurrentOrLeeway { p_moment } => format!(
+                "The current is seen on the ground track alone and no anemometer is logged: \
+                 the wind's leeway sets a ship over ground as a current does, and the yaw \
+                 channel shows no heading-dependent moment (p {}) that would tell a wind. The \
+                 records cannot tell a current from the leeway of a wind too weak to turn the \
+                 ship; the anemometer's columns (apparent wind speed and angle) would.",
+                fmt_p(*p_moment)
+            ),
+            Caveat::ClipOrDeadBand {
+                magnitude_deg,
+                share,
+            } => format!(
+                "The trials' commands hold one magnitude (±{magnitude_deg:.1}° in {:.0} % of \
+                 the commanded samples): an angle limit below it and a dead band take the same \
+                 off every such command and differ only in how the gear moves between them, \
+                 which the model approximates. The records cannot tell a saturation from a \
+                 dead band; commands of several magnitudes would (a PRBS, or zig-zags of two \
+                 amplitudes).",
+                100.0 * share
+            ),
+            Caveat::AsymmetryOrBias {
+                magnitude_deg,
+                share,
+            } => format!(
+                "The trials' commands hold one magnitude (±{magnitude_deg:.1}° in {:.0} % of \
+                 the commanded samples): there a port/starboard asymmetry β (a gain on \
+                 max(δ, 0)) is a steady moment of β·{magnitude_deg:.1}°/2 and a rudder \
+                 effectiveness changed by β/2, and only that change, which the hull's own \
+                 nonlinearity also makes, tells it from a steady moment. The records may not \
+                 tell an asymmetry from a steady moment; commands of several magnitudes would.",
+                100.0 * share
+            ),
+            Caveat::SlewOrDeadTime { step_deg, share } => format!(
+                "The trials' command changes hold one size ({step_deg:.1}° in {:.0} % of the \
+                 changes): a slew limit takes the same time over every such change, so it \
+                 delays each swing by one time as a dead time does, and the two differ only in \
+                 the shape of the gear's ramp, which a slow hull hardly shows. The records may \
+                 not tell a slew limit from a dead time; changes of several sizes would (a \
+                 PRBS, or zig-zags of two amplitudes).",
+                100.0 * share
+            ),
+            Caveat::OtherManoeuvre { distance } => format!(
+                "The trials were sailed with other commands than the reference ({:.0} % of \
+                 their command magnitudes lie where the reference's do not, 1° bins): a linear \
+                 model meets the hull's own nonlinearity differently on other commands, and the \
+                 reference's own spread, which the statistics are judged against, does not \
+                 measure that. An actuator or hull effect named may be the hull's own; sail \
+                 the reference with the trials' manoeuvre.",
+                100.0 * distance
+            ),
+            Caveat::PassedOver { effect } => {
+                let kind = EffectKind::from_name(effect);
+                format!(
+                    "Note: {} ({effect}) is significant but does not improve held-out \
+                     prediction; by the ranking rule no effect that does not improve prediction \
+                     (< {NO_GAIN_PP} pp at 10 steps and in simulation) is named ahead of one \
+                     that does (≥ {GAIN_PP} pp at its own horizon).",
+                    kind.map_or("an effect", effect_phrase)
+                )
+            }
+            Caveat::Outpredicted {
+                effect,
+                gains_pp,
+                by,
+                by_gains_pp,
+            } => {
+                let kind = EffectKind::from_name(effect);
+                format!(
+                    "Note: {} ({effect}) has the larger likelihood statistic but predicts the \
+                     held-out records worse than {by} at 10 steps ({:+.2} pp against {:+.2}) \
+                     and in simulation ({:+.2} pp against {:+.2}); by the ranking rule an \
+                     effect that predicts worse at both horizons (by {NO_GAIN_PP} pp or more \
+                     at one) is not named ahead.",
+                    kind.map_or("an effect", effect_phrase),
+                    gains_pp[0],
+                    by_gains_pp[0],
+                    gains_pp[1],
+                    by_gains_pp[1],
+                )
+            }
+        }
+    }
+}
+
+/// The caveats of a diagnosis, in the order the explanation gives them.
+pub(super) fn caveats(
+    gear_words: Option<&str>,
+    windows: &[Option<Vec<Record>>; 3],
+    has_ref: bool,
+    foreign_pct: Option<f64>,
+    ch: &Channels,
+) -> Vec<Caveat> {
+    let mut out = Vec::new();
+    if let Some(w) = gear_words {
+        out.push(Caveat::ReferenceGear { words: w.into() });
+    }
+    if windows.iter().any(Option::is_some) {
+        let count = |w: &Option<Vec<Record>>| w.as_ref().map_or(0, Vec::len);
+        out.push(Caveat::Blocks {
+            trials: count(&windows[0]),
+            reference: count(&windows[1]),
+            held_out: count(&windows[2]),
+        });
+    }
+    if !has_ref {
+        out.push(Caveat::NoReference);
+    }
+    if let Some(excess_pct) = foreign_pct {
+        out.push(Caveat::ForeignModel { excess_pct });
+    }
+    if !ch.heading_ok {
+        out.push(Caveat::NoHeading);
+    }
+    if !ch.speed_ok {
+        out.push(Caveat::NoSpeedOverGround);
+    }
+    out
+}
+
+/// The caveat for a current named from the ground track alone ([`Caveat::CurrentOrLeeway`]):
+/// of the effects `named` (the verdict's evidence, then its second effect's), a current that
+/// the yaw channel's heading-dependent moment, not an anemometer, set apart from wind
+/// ([`super::verdict::current_or_wind`]), and found absent.
+pub(super) fn current_or_leeway<'a>(
+    named: impl IntoIterator<Item = &'a Evidence>,
+) -> Option<Caveat> {
+    named
+        .into_iter()
+        .filter(|e| e.kind == EffectKind::Current && e.speed_only)
+        .find_map(|e| e.p_moment)
+        .map(|p_moment| Caveat::CurrentOrLeeway { p_moment })
+}
