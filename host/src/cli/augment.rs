@@ -253,6 +253,7 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
     let val = read_checked(&args.read, &args.validate, &given)?;
     let reference = read_checked(&args.read, &args.reference, &given)?;
     let seed = args.seed.resolve_for(&[&reference, &est, &val]);
+    let mut cfg = AugmentConfig::default();
     let (kind, auto, model, then, diagnosed) = match wanted {
         Wanted::Named(k) => (Some(k), false, given.clone(), None, None),
         Wanted::Nothing => (None, false, given.clone(), None, None),
@@ -262,7 +263,9 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
                 gear,
                 then,
                 parameter,
+                damping_form,
             } = choose_auto(&given, &reference, &est, &val, seed, args.null_reps)?;
+            cfg.damping_form = damping_form;
             if let (Some(t), false) = (then, args.more) {
                 println!(
                     "diagnose ranks {} second: --more stacks it after {} when the held-out \
@@ -285,7 +288,6 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
             (kind, true, model, then, parameter)
         }
     };
-    let cfg = AugmentConfig::default();
     let Some(kind) = kind else {
         return write_unchanged(args, outputs, &given, &model, &est, &val, auto, &cfg, None);
     };
@@ -607,6 +609,8 @@ struct Auto {
     then: Option<EffectKind>,
     /// Diagnose's estimate of the verdict's parameter and its uncertainty.
     parameter: Option<(f64, Option<f64>)>,
+    /// The form of nonlinear damping the diagnosis measured (`y³`: true), fitted so.
+    damping_form: Option<bool>,
 }
 
 /// `--effect auto`: the verdict of `diagnose`, printed with its reasons, and what augment
@@ -634,11 +638,16 @@ fn choose_auto(
         .iter()
         .find(|r| r.effect == d.verdict)
         .and_then(|r| r.parameter.map(|p| (p, r.parameter_uncertainty)));
+    let damping_form = d
+        .verdict_effect
+        .filter(|e| e.kind() == EffectKind::NonlinearDamping)
+        .map(|e| e.cubic());
     Ok(Auto {
         kind: d.verdict_kind(),
         gear: d.reference_gear,
         then,
         parameter,
+        damping_form,
     })
 }
 

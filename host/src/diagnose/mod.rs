@@ -257,6 +257,11 @@ pub struct Diagnosis {
     /// measured against, and the better start for augmenting.
     #[serde(skip)]
     pub reference_gear: Option<Model>,
+    /// The verdict's effect as the diagnosis measured it (θ frozen, its gains fitted on the
+    /// trials): its structure and form (nonlinear damping's `y|y|` or `y³`), which
+    /// `augment --effect auto` fits.
+    #[serde(skip)]
+    pub verdict_effect: Option<Effect>,
 }
 
 impl Diagnosis {
@@ -268,7 +273,7 @@ impl Diagnosis {
     /// let d = Diagnosis {
     ///     verdict: "dead-time".into(), ranking: vec![], explanation: String::new(), caveats: vec![],
     ///     reference_used: true, augment: None, then: None, before: Default::default(),
-    ///     after: Default::default(), reference_gear: None,
+    ///     after: Default::default(), reference_gear: None, verdict_effect: None,
     /// };
     /// assert_eq!(d.verdict_kind(), Some(EffectKind::DeadTime));
     /// ```
@@ -459,10 +464,15 @@ pub fn diagnose(
                 .and_then(|(v, g)| verdict::grid_gap(v, g, model.ts));
         }
     }
+    let verdict_effect = verdict.as_ref().map(|(i, _)| ev[*i].best);
     let verdict = verdict.map(|(i, frozen_fits)| {
         let report = if cfg.confirm {
-            crate::diagnose::augment::augment(model, ev[i].kind, &est_part, &held_out, &cfg.augment)
-                .ok()
+            // the damping's form as measured: one parameter, one unit
+            let acfg = augment::AugmentConfig {
+                damping_form: Some(ev[i].best.cubic()),
+                ..cfg.augment.clone()
+            };
+            augment::augment(model, ev[i].kind, &est_part, &held_out, &acfg).ok()
         } else {
             None
         };
@@ -561,6 +571,7 @@ pub fn diagnose(
         before,
         after,
         reference_gear: gear.map(|g| g.model),
+        verdict_effect,
     })
 }
 

@@ -865,3 +865,24 @@ fn a_second_effect_is_measured_against_the_model_with_the_first() {
     assert_eq!(d.verdict, "saturation", "{}", d.explanation);
     assert_eq!(d.then, None, "{}", d.explanation);
 }
+
+#[test]
+fn the_confirming_refit_fits_the_damping_in_the_form_measured() {
+    // the built-in ship's hidden damping (y|y|) on top of its own: θ frozen, the trials
+    // favour one form; the verdict's refit (augment) fits that form, so that diagnose and
+    // augment state one parameter in one unit
+    let refs = records(None, &[900, 901, 902]);
+    let trials = records(Some((EffectKind::NonlinearDamping, 1.0)), &[60, 61, 62]);
+    let cfg = DiagnoseConfig {
+        seed: 6,
+        ..DiagnoseConfig::default()
+    };
+    let d = diagnose(&identify(&refs), &refs, &trials, &[], &cfg).unwrap();
+    assert_eq!(d.verdict, "nonlinear-damping", "{}", d.explanation);
+    let measured = d.verdict_effect.expect("the verdict's effect");
+    let refit = &d.augment.as_ref().expect("the confirming refit").candidate;
+    let refit = refit.effect(EffectKind::NonlinearDamping).unwrap();
+    // measured: y³ (gain −1.43), refit −1.52; before, augment fitted y|y| alone
+    assert!(measured.cubic(), "{measured:?}");
+    assert_eq!(measured.cubic(), refit.cubic(), "{measured:?} {refit:?}");
+}

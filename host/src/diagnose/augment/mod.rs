@@ -115,6 +115,11 @@ pub struct AugmentConfig {
     /// is judged against the input structure re-identified on the estimation part alone
     /// (the reason "validates worse than the input model" is not applied). Default false.
     pub input_in_sample: bool,
+    /// The form nonlinear damping is fitted in: `Some(false)` `y|y|`, `Some(true)` `y³`, or
+    /// `None` (default) both, the one with the lower estimation cost kept. `diagnose` and
+    /// `augment --effect auto` pass the form the diagnosis measured, so that both report
+    /// one parameter in one unit.
+    pub damping_form: Option<bool>,
 }
 
 impl Default for AugmentConfig {
@@ -124,6 +129,7 @@ impl Default for AugmentConfig {
             horizons: Horizon::REPORT.to_vec(),
             parallel: true,
             input_in_sample: false,
+            damping_form: None,
         }
     }
 }
@@ -318,6 +324,19 @@ fn prepare(
     })
 }
 
+/// The forms a regressor or output effect is fitted in, gains at zero: nonlinear damping's
+/// `y|y|` and `y³` (or the one [`AugmentConfig::damping_form`] names), one for the others.
+fn forms(kind: EffectKind, cfg: &AugmentConfig) -> Vec<Effect> {
+    if kind != EffectKind::NonlinearDamping {
+        return vec![Effect::zero(kind, 0.0)];
+    }
+    let damping = |cubic| Effect::NonlinearDamping { beta: 0.0, cubic };
+    match cfg.damping_form {
+        Some(cubic) => vec![damping(cubic)],
+        None => vec![damping(false), damping(true)],
+    }
+}
+
 /// Steps 2–4 for one effect against a prepared baseline.
 fn try_effect(
     model: &Model,
@@ -351,14 +370,16 @@ fn try_effect(
             heading::note(hb),
         )
     } else {
-        let t = model.clone().with_effect(Effect::zero(kind, 0.0));
-        // nested: from the baseline with the new gain at zero the candidate reaches the
-        // baseline's minimum or a lower one on the estimation records
-        let nested = base.model.clone().with_effect(Effect::zero(kind, 0.0));
-        (
-            reidentify_final(est_part, &t, &[nested], cfg).ok(),
-            String::new(),
-        )
+        // every form of the effect (nonlinear damping's y|y| and y³, unless the config names
+        // one), the lowest estimation cost kept: the forms have one gain each
+        let fits = forms(kind, cfg).into_iter().filter_map(|e| {
+            let t = model.clone().with_effect(e);
+            // nested: from the baseline with the new gain at zero the candidate reaches the
+            // baseline's minimum or a lower one on the estimation records
+            let nested = base.model.clone().with_effect(e);
+            reidentify_final(est_part, &t, &[nested], cfg).ok()
+        });
+        (fits.min_by(|a, b| a.cost.total_cmp(&b.cost)), String::new())
     };
     let Some(cand) = cand else {
         let candidate = model.clone().with_effect(Effect::zero(kind, 1.0));

@@ -145,7 +145,19 @@ fn nonlinear_damping_is_found() {
     let e = *r.model.effect(EffectKind::NonlinearDamping).unwrap();
     assert!(matches!(e, Effect::NonlinearDamping { beta, .. } if beta < 0.0));
     assert!(r.fit_gain_pp > 2.0, "{}", r.explanation);
+    // both forms tried, y³ has the lower estimation cost on these records (the hull's own
+    // damping beside the hidden y|y|); held to the hidden form, its n_rr comes back
+    assert!(e.cubic(), "{e:?}");
     let ship = Ship::default_lng();
+    let e = SimEffect::hidden(EffectKind::NonlinearDamping, 1.0);
+    let cfg = AugmentConfig {
+        damping_form: Some(false),
+        ..AugmentConfig::default()
+    };
+    let (est, val) = (recs(&ship, Some(e), &EST), recs(&ship, Some(e), &VAL));
+    let r = augment(base(), EffectKind::NonlinearDamping, &est, &val, &cfg).unwrap();
+    assert!(r.kept, "{}", r.explanation);
+    let e = *r.model.effect(EffectKind::NonlinearDamping).unwrap();
     let Some(SimEffect::NonlinearDamping { n_rr, .. }) = to_sim_effect(&e, &r.model, &ship) else {
         panic!("no n_rr")
     };
@@ -153,6 +165,35 @@ fn nonlinear_damping_is_found() {
         (n_rr - sim::HIDDEN_N_RR).abs() < 0.5 * sim::HIDDEN_N_RR,
         "{n_rr}"
     );
+}
+
+#[test]
+fn nonlinear_damping_is_fitted_in_the_form_the_records_show() {
+    // y³ damping hidden: with both forms tried augment keeps the one of lower estimation
+    // cost (one gain each, so of lower ΔBIC too), here y³; held to one form (the one
+    // diagnose measured, as `--effect auto` passes it) it fits that form
+    let ship = Ship::default_lng();
+    let e = SimEffect::NonlinearDamping {
+        n_rr: sim::HIDDEN_N_RR,
+        cubic: true,
+    };
+    let (est, val) = (recs(&ship, Some(e), &EST), recs(&ship, Some(e), &VAL));
+    let kind = EffectKind::NonlinearDamping;
+    let run = |form| {
+        let cfg = AugmentConfig {
+            damping_form: form,
+            ..AugmentConfig::default()
+        };
+        let r = augment(base(), kind, &est, &val, &cfg).unwrap();
+        (r.candidate.effect(kind).unwrap().cubic(), r.delta_bic)
+    };
+    let (free, free_bic) = run(None);
+    let (square, square_bic) = run(Some(false));
+    let (cube, cube_bic) = run(Some(true));
+    assert!(!square && cube);
+    assert!(free, "y|y| ΔBIC {square_bic}, y³ {cube_bic}");
+    assert_eq!(free_bic.to_bits(), cube_bic.to_bits());
+    assert!(cube_bic < square_bic - 10.0, "{cube_bic} {square_bic}");
 }
 
 #[test]
