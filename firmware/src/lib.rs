@@ -27,8 +27,9 @@
 //!    documented there; the move per step is computed once when the model is loaded); then
 //!    `ũ_prev = ũ`.
 //! 2. heading: `ψ = psi` when given and finite, else `ψ̂`.
-//! 3. `ŷ = x̂_1 + d_y`; `y_used = y` if `y` is finite, else `ŷ`.
-//! 4. `v = Step::effective_input(ũ, y_used, ψ)` of `yawcast_shared::kernel`: `v = ũ`, then
+//! 3. `ŷ = x̂_1 + d_y`; `y_used = y` if `y` is finite, else `ŷ`; the rate the hull turns at
+//!    `ρ = y_used − d_y` (`ρ = y_used` without a gyro offset).
+//! 4. `v = Step::effective_input(ũ, ρ, ψ)` of `yawcast_shared::kernel`: `v = ũ`, then
 //!    for each effect present, in library order, `v = v + β·φ` (bias, asymmetry, nonlinear
 //!    damping, then wind and current from `libm::sincosf` of `r = ψ·(π/180)` and of `r + r`),
 //!    one term at a time as documented there.
@@ -38,7 +39,7 @@
 //!    difference form of `yawcast_shared::model`):
 //!    `x̂'_i = ((x̂_i + x̂_{i+1}) + b_i·v) + k_i·e` for `i < N`;
 //!    `x̂'_N = ((x̂_N + s) + b_N·v) + k_N·e`.
-//! 7. `ψ̂ = ψ + ts·(y_used − d_y)` (heading effect only).
+//! 7. `ψ̂ = ψ + ts·ρ` (heading effect only).
 //! 8. when `x̂'_1 + … + x̂'_N (+ ψ̂)` (summed left to right) is not finite — a component is
 //!    NaN or infinite, or the sum leaves the `f32` range — the whole state is reset to zero
 //!    and [`UpdateStatus::NonFiniteReset`] is returned.
@@ -335,7 +336,8 @@ impl<const N: usize> Predictor<N> {
             _ => st.psi,
         };
         let ut = self.actuator(&mut st, u);
-        let v = self.effective_input(ut, y_used, heading);
+        let rate = self.minus_dy(y_used);
+        let v = self.effective_input(ut, rate, heading);
         let x = st.x;
         let s = self.row_dot(&x);
         for i in 0..N - 1 {
@@ -343,7 +345,7 @@ impl<const N: usize> Predictor<N> {
         }
         st.x[N - 1] = x[N - 1] + s + self.b[N - 1] * v + self.k[N - 1] * e;
         let psi_new = if self.heading {
-            st.psi = heading + self.ts * self.minus_dy(y_used);
+            st.psi = heading + self.ts * rate;
             Some(st.psi)
         } else {
             None
@@ -428,10 +430,11 @@ impl<const N: usize> Predictor<N> {
         ut
     }
 
-    /// `v = ũ + Σ β φ`, accumulated one term at a time in library order.
+    /// `v = ũ + Σ β φ`, accumulated one term at a time in library order; `rate` is the
+    /// rate the hull turns at (the gyro's less its offset).
     #[inline(always)]
-    fn effective_input(&self, ut: f32, y_used: f32, psi: f32) -> f32 {
-        self.fx.effective_input(ut, y_used, psi)
+    fn effective_input(&self, ut: f32, rate: f32, psi: f32) -> f32 {
+        self.fx.effective_input(ut, rate, psi)
     }
 
     /// Predicts `out.len()` = H outputs ŷ(t+1|t) … ŷ(t+H|t) from the current state, with
@@ -519,7 +522,8 @@ impl<const N: usize> Predictor<N> {
             let y_used = prev;
             let heading = st.psi;
             let ut = self.actuator(&mut st, u);
-            let v = self.effective_input(ut, y_used, heading);
+            let rate = self.minus_dy(y_used);
+            let v = self.effective_input(ut, rate, heading);
             let x = st.x;
             let s = self.row_dot(&x);
             for i in 0..N - 1 {
@@ -527,7 +531,7 @@ impl<const N: usize> Predictor<N> {
             }
             st.x[N - 1] = x[N - 1] + s + self.b[N - 1] * v;
             if self.heading {
-                st.psi = heading + self.ts * self.minus_dy(y_used);
+                st.psi = heading + self.ts * rate;
             }
             prev = self.output(&st);
             *o = prev;

@@ -175,7 +175,9 @@ impl<R: Real> Step<R> {
     }
 
     /// `v = ũ + Σ β φ`, accumulated one term at a time in library order: bias, asymmetry
-    /// (`φ = ũ` if `ũ > 0` else `+0`), damping (`y|y|` or `(y·y)·y`), then with
+    /// (`φ = ũ` if `ũ > 0` else `+0`), damping (`ρ|ρ|` or `(ρ·ρ)·ρ` of `rate` = ρ, the
+    /// rate the hull turns at: the measured yaw rate less the gyro's offset `d_y`, so that
+    /// an offset gyro does not move the hull's damping), then with
     /// `r = ψ·(π/180)`, `(sin r, cos r)` and `(sin 2r, cos 2r) = sin_cos(r + r)` the wind's
     /// four terms and the current's two.
     ///
@@ -186,7 +188,7 @@ impl<R: Real> Step<R> {
     /// assert_eq!(s.effective_input(-2.0, 0.0, 0.0), -1.5);
     /// ```
     #[inline(always)]
-    pub fn effective_input(&self, ut: R, y_used: R, psi: R) -> R {
+    pub fn effective_input(&self, ut: R, rate: R, psi: R) -> R {
         let mut v = ut;
         if let Some(beta) = self.bias {
             v = v + beta;
@@ -197,9 +199,9 @@ impl<R: Real> Step<R> {
         }
         if let Some((beta, cubic)) = self.damp {
             let phi = if cubic {
-                y_used * y_used * y_used
+                rate * rate * rate
             } else {
-                y_used * y_used.abs()
+                rate * rate.abs()
             };
             v = v + beta * phi;
         }

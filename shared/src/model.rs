@@ -121,7 +121,8 @@ pub enum Effect<R = f32> {
         /// Gain β.
         beta: R,
     },
-    /// Hull damping beyond linear (Norrbin): `φ = y|y|` (or `y³`) through B.
+    /// Hull damping beyond linear (Norrbin): `φ = ρ|ρ|` (or `ρ³`) through B, of the rate
+    /// the hull turns at, `ρ = y − d_y` (the gyro's reading less its offset).
     NonlinearDamping {
         /// Gain β.
         beta: R,

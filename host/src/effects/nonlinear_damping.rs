@@ -1,4 +1,4 @@
-//! `nonlinear-damping`: hull damping beyond linear (Norrbin), `φ = y|y|` or `y³` through B.
+//! `nonlinear-damping`: hull damping beyond linear (Norrbin), `φ = ρ|ρ|` or `ρ³`, `ρ = y − d_y`.
 
 use super::{no_search, Channel, Def, Effect, Field, Fields, Regressor, Role, SimEffect, SimKnobs};
 use yawcast_shared::model::EffectKind;

@@ -5,13 +5,14 @@
 //! 1. actuator: `delayed = u(t−d)`, then `yawcast_shared::kernel::Step::actuator` (limit,
 //!    dead band, largest move per step, each optional);
 //! 2. heading `ψ` = measured ψ when given, else the integrated `ψ̂`;
-//! 3. `y_used` = measured y when finite, else `ŷ = x̂₁ + d_y`;
+//! 3. `y_used` = measured y when finite, else `ŷ = x̂₁ + d_y`; the hull's rate
+//!    `ρ = y_used − d_y`;
 //! 4. `v = ũ + Σ β φ` (`yawcast_shared::kernel::Step::effective_input`: bias 1, asymmetry
-//!    max(ũ,0), damping y|y| or y³, wind sin2ψ, cos2ψ, sinψ, cosψ, current sinψ, cosψ; ψ in
+//!    max(ũ,0), damping ρ|ρ| or ρ³, wind sin2ψ, cos2ψ, sinψ, cosψ, current sinψ, cosψ; ψ in
 //!    degrees), accumulated one term at a time;
 //! 5. `e = y − ŷ` (0 when y is missing);
 //! 6. `x̂' = A x̂ + B v + K e`;
-//! 7. `ψ̂' = ψ + Ts·(y_used − d_y)`.
+//! 7. `ψ̂' = ψ + Ts·ρ`.
 //!
 //! k-step prediction (MATLAB `predict`): `ŷ(t|t−k)` starts from the one-step state
 //! `x̂(t−k+1|t−k)` and runs k−1 open-loop steps (no measurements, `e = 0`, `y_used = ŷ`).
@@ -193,10 +194,11 @@ impl Stepper {
         ut
     }
 
-    /// The effective input `v = ũ + Σβφ` for actuator output `ut`, output `y_used`,
-    /// heading `psi` (deg), accumulated as the firmware does.
-    pub fn effective_input(&self, ut: f64, y_used: f64, psi: f64) -> f64 {
-        self.fx.effective_input(ut, y_used, psi)
+    /// The effective input `v = ũ + Σβφ` for actuator output `ut`, the hull's rate `rate`
+    /// (the yaw rate used less the gyro offset `d_y`), heading `psi` (deg), accumulated as
+    /// the firmware does.
+    pub fn effective_input(&self, ut: f64, rate: f64, psi: f64) -> f64 {
+        self.fx.effective_input(ut, rate, psi)
     }
 
     /// One filter step with command `u`, measurement `y` (NaN = missing) and optional
@@ -213,7 +215,8 @@ impl Stepper {
         } else {
             (yhat, 0.0)
         };
-        let v = self.effective_input(ut, y_used, psi);
+        let rate = y_used - self.d_y;
+        let v = self.effective_input(ut, rate, psi);
         let n = self.n;
         let x = st.x;
         let mut last = 0.0;
@@ -224,7 +227,7 @@ impl Stepper {
             st.x[i] = x[i + 1] + self.b[i] * v + self.k[i] * e;
         }
         st.x[n - 1] = last + self.b[n - 1] * v + self.k[n - 1] * e;
-        st.psi = psi + self.ts * (y_used - self.d_y);
+        st.psi = psi + self.ts * rate;
         StepOut { yhat, u_eff: ut, v }
     }
 }

@@ -7,8 +7,8 @@
 //! the compass's turn, which only a sensor offset moves — so where every record logs heading
 //! the offset is taken from there. The shift is exact: with `y = x₁ + d_y` the innovations of
 //! the model with `d_y` on `y` are those of the model without it on `y − d_y`, and a fit % is
-//! the same on either — unless an effect reads the measured yaw rate itself (nonlinear
-//! damping's `y|y|`), where the offset is estimated with θ as before.
+//! the same on either — nonlinear damping included, which reads the rate the hull turns at,
+//! `y − d_y` (`yawcast_shared::kernel::Step::effective_input`).
 
 use yawcast_shared::model::EffectKind;
 
@@ -16,14 +16,10 @@ use crate::identify::model::{Effect, Model};
 use crate::identify::pem::PemReport;
 use crate::io::data::{heading_bias, HeadingBias, Record};
 
-/// The offset the heading measures on `est`, when `kind` is a gyro offset, every record logs
-/// heading, and no effect of `model` reads the measured yaw rate.
-pub(super) fn measured_offset(
-    kind: EffectKind,
-    model: &Model,
-    est: &[Record],
-) -> Option<HeadingBias> {
-    if kind != EffectKind::GyroBias || model.effect(EffectKind::NonlinearDamping).is_some() {
+/// The offset the heading measures on `est`, when `kind` is a gyro offset and every record
+/// logs heading.
+pub(super) fn measured_offset(kind: EffectKind, est: &[Record]) -> Option<HeadingBias> {
+    if kind != EffectKind::GyroBias {
         return None;
     }
     heading_bias(est).filter(|h| h.bias.is_finite() && h.se.is_finite())
@@ -114,26 +110,43 @@ mod tests {
         let rec = Record::from_uy("r", 1.0, u, y);
         let h = predict::Horizon::Steps(10);
         let a = predict::predict(&with, &rec, &[0.0, 0.0], h);
-        let b = predict::predict(&m, &shifted(&[rec], 0.25)[0], &[0.0, 0.0], h);
+        let b = predict::predict(
+            &m,
+            &shifted(std::slice::from_ref(&rec), 0.25)[0],
+            &[0.0, 0.0],
+            h,
+        );
         for (p, q) in a.iter().zip(&b) {
             assert!((p - (q + 0.25)).abs() < 1e-12, "{p} {q}");
         }
         assert_eq!(without_offset(&with), m);
+        // nonlinear damping too: it reads the rate the hull turns at, y − d_y, so an offset
+        // gyro does not move the damping (before, it read the measured y)
+        for cubic in [false, true] {
+            let damped = m
+                .clone()
+                .with_effect(Effect::NonlinearDamping { beta: -0.1, cubic });
+            let with = damped.clone().with_effect(Effect::GyroBias { d_y: 0.25 });
+            let a = predict::predict(&with, &rec, &[0.0, 0.0], h);
+            let b = predict::predict(
+                &damped,
+                &shifted(std::slice::from_ref(&rec), 0.25)[0],
+                &[0.0, 0.0],
+                h,
+            );
+            for (p, q) in a.iter().zip(&b) {
+                assert!((p - (q + 0.25)).abs() < 1e-12, "{cubic}: {p} {q}");
+            }
+        }
     }
 
     #[test]
-    fn only_a_gyro_offset_on_records_with_heading_and_no_damping() {
-        let m = Model::new(1.0, vec![-0.3, 0.9], vec![0.5, 0.4], vec![0.2, 0.1]).unwrap();
+    fn only_a_gyro_offset_on_records_with_heading() {
         let mut r = Record::from_uy("x", 1.0, vec![0.0; 400], vec![1.2; 400]);
-        assert!(measured_offset(EffectKind::GyroBias, &m, &[r.clone()]).is_none());
+        assert!(measured_offset(EffectKind::GyroBias, &[r.clone()]).is_none());
         r.psi = Some((0..400).map(|i| i as f64).collect());
-        let hb = measured_offset(EffectKind::GyroBias, &m, &[r.clone()]).unwrap();
+        let hb = measured_offset(EffectKind::GyroBias, &[r.clone()]).unwrap();
         assert!((hb.bias - 0.2).abs() < 1e-12);
-        assert!(measured_offset(EffectKind::Bias, &m, &[r.clone()]).is_none());
-        let damped = m.with_effect(Effect::NonlinearDamping {
-            beta: -0.1,
-            cubic: false,
-        });
-        assert!(measured_offset(EffectKind::GyroBias, &damped, &[r]).is_none());
+        assert!(measured_offset(EffectKind::Bias, &[r]).is_none());
     }
 }

@@ -358,7 +358,7 @@ fn try_effect(
     let held_note = held_note.clone();
 
     // candidate
-    let offset = heading::measured_offset(kind, model, est_part);
+    let offset = heading::measured_offset(kind, est_part);
     let (cand, search_note) = if kind.is_actuator() {
         actuator_candidate(kind, model, &base.model, est_part, cfg)
     } else if let Some(hb) = offset {
@@ -404,7 +404,7 @@ fn try_effect(
     let mut cand_model = cand.model.clone();
     let mut std_pct = cand.std_pct.clone();
     if j.kept && held_note.is_some() {
-        let full = match heading::measured_offset(kind, model, est) {
+        let full = match heading::measured_offset(kind, est) {
             Some(hb) => reidentify_warm(
                 &heading::shifted(est, hb.bias),
                 &heading::without_offset(&cand.model),

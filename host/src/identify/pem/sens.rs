@@ -252,6 +252,8 @@ fn pass_n<const N: usize, S: Sink>(
             _ => (false, psi_prev),
         };
         let (y_used, e) = if yfin { (y, y - o.yhat) } else { (o.yhat, 0.0) };
+        // the hull turns at the rate the gyro reads less its offset
+        let z = y_used - stepper.d_y();
         // Regressors and partials of v = ũ + Σβφ.
         let (mut s1, mut c1, mut s2, mut c2) = (0.0, 0.0, 0.0, 0.0);
         if lay.heading {
@@ -266,9 +268,9 @@ fn pass_n<const N: usize, S: Sink>(
                 Regressor::Starboard => o.u_eff.max(0.0),
                 Regressor::Damping => {
                     if lay.cubic {
-                        y_used * y_used * y_used
+                        z * z * z
                     } else {
-                        y_used * y_used.abs()
+                        z * z.abs()
                     }
                 }
                 Regressor::Sin2 => s2,
@@ -277,12 +279,12 @@ fn pass_n<const N: usize, S: Sink>(
                 Regressor::Cos1 => c1,
             };
         }
-        let dv_dy = if yfin || damp == 0.0 {
+        let dv_dz = if damp == 0.0 {
             0.0
         } else if lay.cubic {
-            3.0 * damp * y_used * y_used
+            3.0 * damp * z * z
         } else {
-            2.0 * damp * y_used.abs()
+            2.0 * damp * z.abs()
         };
         let dv_dpsi = if lay.heading && !psi_meas {
             let d = std::f64::consts::PI / 180.0;
@@ -301,7 +303,7 @@ fn pass_n<const N: usize, S: Sink>(
             } else {
                 0.0
             };
-            let mut dv = dv_dy * dyu + dv_dpsi * dpsi;
+            let mut dv = dv_dz * (dyu - ddy) + dv_dpsi * dpsi;
             if j >= nt && j < p {
                 dv += phi[j - nt];
             }
