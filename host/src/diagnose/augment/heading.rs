@@ -100,42 +100,33 @@ mod tests {
     #[test]
     fn the_shift_is_exact() {
         // the model with an offset on y predicts as the model without it on y − offset,
-        // shifted back
+        // shifted back — with nonlinear damping too: it reads the rate the hull turns at,
+        // y − d_y, so an offset gyro does not move the damping (before, it read y itself)
         let m = Model::new(1.0, vec![-0.3, 0.9], vec![0.5, 0.4], vec![0.2, 0.1]).unwrap();
-        let with = m.clone().with_effect(Effect::GyroBias { d_y: 0.25 });
         let u: Vec<f64> = (0..200)
             .map(|i| ((i / 13) % 2) as f64 * 4.0 - 2.0)
             .collect();
         let y: Vec<f64> = (0..200).map(|i| (i as f64 * 0.1).sin() + 0.25).collect();
         let rec = Record::from_uy("r", 1.0, u, y);
+        let less = shifted(std::slice::from_ref(&rec), 0.25).remove(0);
         let h = predict::Horizon::Steps(10);
-        let a = predict::predict(&with, &rec, &[0.0, 0.0], h);
-        let b = predict::predict(
-            &m,
-            &shifted(std::slice::from_ref(&rec), 0.25)[0],
-            &[0.0, 0.0],
-            h,
-        );
-        for (p, q) in a.iter().zip(&b) {
-            assert!((p - (q + 0.25)).abs() < 1e-12, "{p} {q}");
-        }
-        assert_eq!(without_offset(&with), m);
-        // nonlinear damping too: it reads the rate the hull turns at, y − d_y, so an offset
-        // gyro does not move the damping (before, it read the measured y)
-        for cubic in [false, true] {
-            let damped = m
-                .clone()
-                .with_effect(Effect::NonlinearDamping { beta: -0.1, cubic });
-            let with = damped.clone().with_effect(Effect::GyroBias { d_y: 0.25 });
+        let damping = |cubic| Effect::NonlinearDamping { beta: -0.1, cubic };
+        let models = [
+            m.clone(),
+            m.clone().with_effect(damping(false)),
+            m.with_effect(damping(true)),
+        ];
+        for without in models {
+            let with = without.clone().with_effect(Effect::GyroBias { d_y: 0.25 });
+            assert_eq!(without_offset(&with), without);
             let a = predict::predict(&with, &rec, &[0.0, 0.0], h);
-            let b = predict::predict(
-                &damped,
-                &shifted(std::slice::from_ref(&rec), 0.25)[0],
-                &[0.0, 0.0],
-                h,
-            );
+            let b = predict::predict(&without, &less, &[0.0, 0.0], h);
             for (p, q) in a.iter().zip(&b) {
-                assert!((p - (q + 0.25)).abs() < 1e-12, "{cubic}: {p} {q}");
+                assert!(
+                    (p - (q + 0.25)).abs() < 1e-12,
+                    "{:?}: {p} {q}",
+                    without.effects
+                );
             }
         }
     }
