@@ -620,3 +620,81 @@ fn augment_more_searches_the_library_and_pins_its_json() {
     assert!(!w["more"]["added"].as_array().unwrap().is_empty(), "{w}");
     assert_eq!(w["effects"], w["more"]["added"]);
 }
+
+#[test]
+fn augment_auto_states_the_damping_in_the_form_diagnose_measured() {
+    // the built-in ship's hidden damping: diagnose measures it in one form (θ frozen) and
+    // augment fits that form, so the estimate check compares one parameter in one unit
+    // (before, augment fitted y|y| alone and printed diagnose's y³ gain per (°/s)²)
+    use yawcast::sim::{simulate, Scenario, Ship, SimEffect};
+    use yawcast_shared::model::EffectKind;
+    let d = scratch("damping-form");
+    let ship = Ship::default_lng();
+    let write = |name: &str, effect: Option<SimEffect>, seeds: &[u64]| -> Vec<String> {
+        let sc = Scenario {
+            effects: effect.into_iter().collect(),
+            ..Scenario::default()
+        };
+        seeds
+            .iter()
+            .map(|&seed| {
+                let p = d.join(format!("{name}-{seed}.csv"));
+                yawcast::io::data::write_csv(&p, &simulate(&ship, &sc, seed).unwrap()).unwrap();
+                p.display().to_string()
+            })
+            .collect()
+    };
+    let reference = write("ref", None, &[601, 602, 603]);
+    let recs: Vec<_> = reference
+        .iter()
+        .map(|p| yawcast::io::data::read_csv(Path::new(p)).unwrap())
+        .collect();
+    let base = yawcast::identify::pem::identify(&recs, None, &Default::default())
+        .unwrap()
+        .model;
+    let model = d.join("base.json");
+    std::fs::write(&model, serde_json::to_string(&base).unwrap()).unwrap();
+    let damping = SimEffect::hidden(EffectKind::NonlinearDamping, 1.0);
+    let est = write("trial", Some(damping), &[61, 62, 63]);
+    let (out, json) = (d.join("aug"), d.join("aug-summary.json"));
+    let mut args: Vec<String> = ["augment", "--model", &model.display().to_string()]
+        .map(String::from)
+        .to_vec();
+    args.extend(["--effect", "auto", "--seed", "1"].map(String::from));
+    for r in &reference {
+        args.extend(["--reference".into(), r.clone()]);
+    }
+    for t in &est {
+        args.extend(["--data".into(), t.clone()]);
+    }
+    args.extend(["--out".into(), out.display().to_string()]);
+    args.extend(["--json".into(), json.display().to_string()]);
+    let o = run(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(code(&o), 0, "{}\n{}", stdout(&o), stderr(&o));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["effect"], "nonlinear-damping", "{}", stdout(&o));
+    let twin: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("aug.json")).unwrap()).unwrap();
+    let written = twin["model"]["effects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|e| e["effect"] == "nonlinear-damping")
+        .unwrap_or_else(|| panic!("{twin}"));
+    let c = &v["estimate_check"];
+    let unit = if written["cubic"] == true {
+        "° of command per (°/s)³"
+    } else {
+        "° of command per (°/s)²"
+    };
+    assert_eq!(c["unit"], unit, "{c}");
+    // one parameter in one unit: the two estimates of the same sign, within a factor of 2
+    // (measured: y³, augment −1.62, diagnose −1.52; augment's y|y| fit was −4 per (°/s)²)
+    assert_eq!(written["cubic"], true, "{written}");
+    let (a, g) = (
+        c["augment"].as_f64().unwrap(),
+        c["diagnose"].as_f64().unwrap(),
+    );
+    assert!(a < 0.0 && g < 0.0 && a / g > 0.5 && a / g < 2.0, "{c}");
+}
