@@ -160,6 +160,21 @@ pub(crate) fn sim_csvs(
         .collect()
 }
 
+/// The model identified (PEM, defaults) on the records `csvs`, written as `dir/base.json`:
+/// a reference model for `diagnose` and `augment`.
+pub(crate) fn model_from(dir: &Path, csvs: &[PathBuf]) -> PathBuf {
+    let recs: Vec<_> = csvs
+        .iter()
+        .map(|p| yawcast::io::data::read_csv(p).unwrap())
+        .collect();
+    let base = yawcast::identify::pem::identify(&recs, None, &Default::default())
+        .unwrap()
+        .model;
+    let model = dir.join("base.json");
+    std::fs::write(&model, serde_json::to_string(&base).unwrap()).unwrap();
+    model
+}
+
 /// Runs `yawcast` with a time limit: a hang is a failure, not a stuck test run.
 pub(crate) fn run_limited(args: &[String], limit: std::time::Duration) -> Option<Output> {
     use std::process::Stdio;

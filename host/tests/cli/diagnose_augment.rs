@@ -205,15 +205,7 @@ fn augment_auto_on_a_slow_gear_reference_names_and_keeps_a_slower_slew_limit() {
             .collect()
     };
     let reference = write("ref", None, &[501, 502]);
-    let recs: Vec<_> = reference
-        .iter()
-        .map(|p| yawcast::io::data::read_csv(p).unwrap())
-        .collect();
-    let base = yawcast::identify::pem::identify(&recs, None, &Default::default())
-        .unwrap()
-        .model;
-    let model = d.join("base.json");
-    std::fs::write(&model, serde_json::to_string(&base).unwrap()).unwrap();
+    let model = model_from(&d, &reference);
     let slower = SimEffect::hidden(EffectKind::RateLimit, 1.0);
     let est = write("trial", Some(slower), &[1, 2]);
     let val = write("check", Some(slower), &[11]);
@@ -393,15 +385,7 @@ fn augment_adds_a_dead_time_exports_it_and_writes_the_ship() {
     let d = scratch("augment");
     // the model of the effect-free simulator, as a JSON twin
     let reference = sim_csvs(&d, "ref", None, &[301, 302]);
-    let recs: Vec<_> = reference
-        .iter()
-        .map(|p| yawcast::io::data::read_csv(p).unwrap())
-        .collect();
-    let base = yawcast::identify::pem::identify(&recs, None, &Default::default())
-        .unwrap()
-        .model;
-    let model = d.join("base.json");
-    std::fs::write(&model, serde_json::to_string(&base).unwrap()).unwrap();
+    let model = model_from(&d, &reference);
     let hidden = SimEffect::hidden(EffectKind::DeadTime, 1.0);
     let est = sim_csvs(&d, "trial", Some(hidden), &[1, 2, 3]);
     let val = sim_csvs(&d, "check", Some(hidden), &[11, 12]);
@@ -527,15 +511,7 @@ fn augment_more_searches_the_library_and_pins_its_json() {
     use yawcast_shared::model::EffectKind;
     let d = scratch("augment-more");
     let reference = sim_csvs(&d, "ref", None, &[311, 312]);
-    let recs: Vec<_> = reference
-        .iter()
-        .map(|p| yawcast::io::data::read_csv(p).unwrap())
-        .collect();
-    let base = yawcast::identify::pem::identify(&recs, None, &Default::default())
-        .unwrap()
-        .model;
-    let model = d.join("base.json");
-    std::fs::write(&model, serde_json::to_string(&base).unwrap()).unwrap();
+    let model = model_from(&d, &reference);
     let hidden = SimEffect::hidden(EffectKind::Asymmetry, 1.0);
     let est = sim_csvs(&d, "trial", Some(hidden), &[21, 22]);
     let val = sim_csvs(&d, "check", Some(hidden), &[31, 32]);
@@ -626,46 +602,23 @@ fn augment_auto_states_the_damping_in_the_form_diagnose_measured() {
     // the built-in ship's hidden damping: diagnose measures it in one form (θ frozen) and
     // augment fits that form, so the estimate check compares one parameter in one unit
     // (before, augment fitted y|y| alone and printed diagnose's y³ gain per (°/s)²)
-    use yawcast::sim::{simulate, Scenario, Ship, SimEffect};
+    use yawcast::sim::SimEffect;
     use yawcast_shared::model::EffectKind;
     let d = scratch("damping-form");
-    let ship = Ship::default_lng();
-    let write = |name: &str, effect: Option<SimEffect>, seeds: &[u64]| -> Vec<String> {
-        let sc = Scenario {
-            effects: effect.into_iter().collect(),
-            ..Scenario::default()
-        };
-        seeds
-            .iter()
-            .map(|&seed| {
-                let p = d.join(format!("{name}-{seed}.csv"));
-                yawcast::io::data::write_csv(&p, &simulate(&ship, &sc, seed).unwrap()).unwrap();
-                p.display().to_string()
-            })
-            .collect()
-    };
-    let reference = write("ref", None, &[601, 602, 603]);
-    let recs: Vec<_> = reference
-        .iter()
-        .map(|p| yawcast::io::data::read_csv(Path::new(p)).unwrap())
-        .collect();
-    let base = yawcast::identify::pem::identify(&recs, None, &Default::default())
-        .unwrap()
-        .model;
-    let model = d.join("base.json");
-    std::fs::write(&model, serde_json::to_string(&base).unwrap()).unwrap();
+    let reference = sim_csvs(&d, "ref", None, &[601, 602, 603]);
+    let model = model_from(&d, &reference);
     let damping = SimEffect::hidden(EffectKind::NonlinearDamping, 1.0);
-    let est = write("trial", Some(damping), &[61, 62, 63]);
+    let est = sim_csvs(&d, "trial", Some(damping), &[61, 62, 63]);
     let (out, json) = (d.join("aug"), d.join("aug-summary.json"));
     let mut args: Vec<String> = ["augment", "--model", &model.display().to_string()]
         .map(String::from)
         .to_vec();
     args.extend(["--effect", "auto", "--seed", "1"].map(String::from));
     for r in &reference {
-        args.extend(["--reference".into(), r.clone()]);
+        args.extend(["--reference".into(), r.display().to_string()]);
     }
     for t in &est {
-        args.extend(["--data".into(), t.clone()]);
+        args.extend(["--data".into(), t.display().to_string()]);
     }
     args.extend(["--out".into(), out.display().to_string()]);
     args.extend(["--json".into(), json.display().to_string()]);
