@@ -65,6 +65,7 @@ use thiserror::Error;
 use yawcast_shared::model::EffectKind;
 
 use crate::diagnose::compare::{check_inputs, InputError};
+use crate::effects::GridSpan;
 use crate::identify::model::{Effect, Model};
 use crate::identify::pem::{IdentError, PemConfig, PemReport};
 use crate::identify::predict::Horizon;
@@ -324,17 +325,18 @@ fn prepare(
     })
 }
 
-/// The forms a regressor or output effect is fitted in, gains at zero: nonlinear damping's
-/// `y|y|` and `y³` (or the one [`AugmentConfig::damping_form`] names), one for the others.
-fn forms(kind: EffectKind, cfg: &AugmentConfig) -> Vec<Effect> {
-    if kind != EffectKind::NonlinearDamping {
-        return vec![Effect::zero(kind, 0.0)];
-    }
-    let damping = |cubic| Effect::NonlinearDamping { beta: 0.0, cubic };
-    match cfg.damping_form {
-        Some(cubic) => vec![damping(cubic)],
-        None => vec![damping(false), damping(true)],
-    }
+/// The forms a regressor or output effect is fitted in, gains at zero: the effect's own
+/// candidates ([`crate::effects::Def::candidates`]: nonlinear damping's `y|y|` and `y³`,
+/// one for the others), the damping held to the form [`AugmentConfig::damping_form`] names.
+fn forms(kind: EffectKind, cfg: &AugmentConfig, est: &[Record], ts: f64) -> Vec<Effect> {
+    let span = GridSpan::of(ts, est.iter().map(|r| &r.u[..]));
+    (crate::effects::def(kind).candidates)(&span)
+        .into_iter()
+        .filter(|e| {
+            kind != EffectKind::NonlinearDamping
+                || cfg.damping_form.map_or(true, |c| e.cubic() == c)
+        })
+        .collect()
 }
 
 /// Steps 2–4 for one effect against a prepared baseline.
@@ -372,13 +374,15 @@ fn try_effect(
     } else {
         // every form of the effect (nonlinear damping's y|y| and y³, unless the config names
         // one), the lowest estimation cost kept: the forms have one gain each
-        let fits = forms(kind, cfg).into_iter().filter_map(|e| {
-            let t = model.clone().with_effect(e);
-            // nested: from the baseline with the new gain at zero the candidate reaches the
-            // baseline's minimum or a lower one on the estimation records
-            let nested = base.model.clone().with_effect(e);
-            reidentify_final(est_part, &t, &[nested], cfg).ok()
-        });
+        let fits = forms(kind, cfg, est_part, model.ts)
+            .into_iter()
+            .filter_map(|e| {
+                let t = model.clone().with_effect(e);
+                // nested: from the baseline with the new gain at zero the candidate reaches the
+                // baseline's minimum or a lower one on the estimation records
+                let nested = base.model.clone().with_effect(e);
+                reidentify_final(est_part, &t, &[nested], cfg).ok()
+            });
         (fits.min_by(|a, b| a.cost.total_cmp(&b.cost)), String::new())
     };
     let Some(cand) = cand else {
