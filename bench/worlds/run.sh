@@ -307,7 +307,8 @@ if won:
             lost = [(o - l, 100.0 * (a - l) / (o - l)) for o, l, a, _ in cs if o - l >= 3.0]
             line = (f"| {w} | {st} | {len(cs)} | {len(lost)} | "
                     + (f"{statistics.median(x[0] for x in lost):.1f} | "
-                       f"{down(statistics.median(x[1] for x in lost))} % | " if lost else "– | – | ")
+                       f"{down(statistics.median(x[1] for x in lost))} % | "
+                       if lost else "– | – | ")
                     + f"{sum(x[1] >= 60 for x in lost)}/{len(lost)} |")
             if gap0 is None:
                 line += " – | – | – | – |"
@@ -319,7 +320,8 @@ if won:
                          + f" {sum(x >= 60 for x in net)}/{len(net)} |")
             more = [100.0 * (m - l) / (o - l) for o, l, _, m in cs
                     if o - l >= 3.0 and m is not None]
-            line += ((f" {down(statistics.median(more))} % | {sum(x >= 60 for x in more)}/{len(more)} |")
+            line += ((f" {down(statistics.median(more))} % |"
+                      f" {sum(x >= 60 for x in more)}/{len(more)} |")
                      if more else " – | – |")
             print(line)
     print("\nPer case (oracle / best linear / augment --effect auto / with --more, fit % at 10 "
