@@ -638,10 +638,7 @@ fn choose_auto(
         .iter()
         .find(|r| r.effect == d.verdict)
         .and_then(|r| r.parameter.map(|p| (p, r.parameter_uncertainty)));
-    let damping_form = d
-        .verdict_effect
-        .filter(|e| e.kind() == EffectKind::NonlinearDamping)
-        .map(|e| e.cubic());
+    let damping_form = d.verdict_effect.and_then(|e| e.damping_form());
     Ok(Auto {
         kind: d.verdict_kind(),
         gear: d.reference_gear,

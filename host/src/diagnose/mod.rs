@@ -469,7 +469,7 @@ pub fn diagnose(
         let report = if cfg.confirm {
             // the damping's form as measured: one parameter, one unit
             let acfg = augment::AugmentConfig {
-                damping_form: Some(ev[i].best.cubic()),
+                damping_form: ev[i].best.damping_form(),
                 ..cfg.augment.clone()
             };
             augment::augment(model, ev[i].kind, &est_part, &held_out, &acfg).ok()

@@ -304,6 +304,21 @@ impl Effect {
         matches!(self, Effect::NonlinearDamping { cubic: true, .. })
     }
 
+    /// The form of a nonlinear damping (`Some(true)` for `y³`), `None` for every other
+    /// effect: what [`crate::diagnose::augment::AugmentConfig::damping_form`] takes.
+    ///
+    /// ```
+    /// use yawcast::identify::model::Effect;
+    /// assert_eq!(Effect::NonlinearDamping { beta: -1.0, cubic: true }.damping_form(), Some(true));
+    /// assert_eq!(Effect::Bias { beta: 1.0 }.damping_form(), None);
+    /// ```
+    pub fn damping_form(&self) -> Option<bool> {
+        match self {
+            Effect::NonlinearDamping { cubic, .. } => Some(*cubic),
+            _ => None,
+        }
+    }
+
     /// The f32 schema's effect (parameters rounded to f32; a dead time capped at 255).
     pub fn to_spec(self) -> sm::Effect {
         self.to_kernel().map(|x| x as f32)
