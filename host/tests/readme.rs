@@ -9,7 +9,8 @@
 //!   exists (`--out PATH` of a model: `PATH.postcard` and `PATH.json`);
 //! - every JSON field a `#   FILE.json: a, b.c` comment line names is present in that file;
 //! - what the README says of seed 1 below the session holds: `diagnose` names `gyro-bias`,
-//!   `augment` keeps it and writes it into `my-ship.toml`, the blob is 76 bytes.
+//!   `augment` adds it to the ship's own damping and angle limit, keeps it and writes it
+//!   (only it) into `my-ship.toml`, the blob is 87 bytes.
 //!
 //! The demo's QEMU check is left out (`YAWCAST_FW_ELF` removed): `.ci/browser-test.sh` runs
 //! it, and the demo says when it skipped it.
@@ -212,15 +213,27 @@ fn readme_session_runs_verbatim() {
     let augment = read_json(&run.join("mine/augment.json"));
     assert_eq!(augment["effect"], "gyro-bias", "{augment:#}");
     assert_eq!(augment["kept"], true, "{augment:#}");
+    assert_eq!(
+        augment["effects"],
+        serde_json::json!(["nonlinear-damping", "saturation", "gyro-bias"]),
+        "{augment:#}"
+    );
+    let twin = read_json(&run.join("mine/augmented.json"));
+    let limit = twin["model"]["effects"][1]["limit"].as_f64().unwrap();
+    assert!((18.5..19.5).contains(&limit), "{limit}");
     let ship = std::fs::read_to_string(run.join("my-ship.toml")).unwrap();
     assert!(ship.contains("kind = \"gyro-bias\""), "{ship}");
+    assert!(
+        !ship.contains("damping") && !ship.contains("saturation"),
+        "{ship}"
+    );
     let export = read_json(&run.join("mine/export.json"));
-    assert_eq!(export["blob_len"], 76, "{export:#}");
+    assert_eq!(export["blob_len"], 87, "{export:#}");
     assert_eq!(
         std::fs::metadata(run.join("mine/controller.postcard"))
             .unwrap()
             .len(),
-        76
+        87
     );
 
     let _ = std::fs::remove_dir_all(&root);

@@ -274,28 +274,58 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
                     kind.map_or("the verdict", |k| k.name())
                 );
             }
-            let model = match gear {
-                Some(g) => {
-                    let check = if val.is_empty() { &est } else { &val };
-                    let (m, why) = augment::gear_base(&given, g, kind, check);
-                    if let Some(w) = why.explain(given.ts) {
-                        println!("{w}");
-                    }
-                    m
-                }
-                None => given.clone(),
-            };
+            let check = if val.is_empty() { &est } else { &val };
+            let trial_effects: Vec<EffectKind> = kind.into_iter().chain(then).collect();
+            let (model, why) =
+                augment::own_base(&given, gear, &trial_effects, &reference, check, &cfg);
+            if let Some(w) = why.explain(given.ts) {
+                println!("{w}");
+            }
             (kind, true, model, then, parameter)
         }
     };
     let Some(kind) = kind else {
-        return write_unchanged(args, outputs, &given, &model, &est, &val, auto, &cfg, None);
+        if !auto {
+            return write_unchanged(args, outputs, &given, &model, &est, &val, auto, &cfg, None);
+        }
+        // nothing missing, but the trials are the ship's own records: the structure is
+        // re-identified on them and judged as augment judges a model without an added effect
+        let rep = augment::refit(&model, &est, &val, &cfg).map_err(cli_err)?;
+        println!("{}", rep.explanation);
+        let model = rep.model.clone();
+        let again = Again {
+            kind: None,
+            rep,
+            then: None,
+        };
+        return write_unchanged(
+            args,
+            outputs,
+            &given,
+            &model,
+            &est,
+            &val,
+            auto,
+            &cfg,
+            Some(again),
+        );
     };
     if auto && model.effect(kind).is_some() {
         // diagnose tested the model's own effect for a change: re-estimate it, do not add it
-        let rep = augment::reestimate(&model, kind, &est, &val, &cfg).map_err(cli_err)?;
-        println!("{}", rep.explanation);
-        let again = Again { kind, rep, then };
+        let r = augment::reestimate(&model, kind, &est, &val, &cfg).map_err(cli_err)?;
+        println!("{}", r.explanation);
+        let rep = augment::Refitted {
+            model: r.model,
+            written: r.written,
+            before: r.before,
+            after: r.after,
+            explanation: r.explanation,
+        };
+        let again = Again {
+            kind: Some(kind),
+            rep,
+            then,
+        };
         let model = again.rep.model.clone();
         return write_unchanged(
             args,
@@ -470,10 +500,12 @@ fn search_more(
     Ok(Some(f))
 }
 
-/// `--effect auto` whose verdict the model carries already: its value re-estimated.
+/// `--effect auto` with the verdict `none` (the structure re-identified on the trials) or one
+/// the model carries already (its value re-estimated with the rest).
 struct Again {
-    kind: EffectKind,
-    rep: augment::Reestimated,
+    /// The verdict (`None` for `none`).
+    kind: Option<EffectKind>,
+    rep: augment::Refitted,
     then: Option<EffectKind>,
 }
 
@@ -523,15 +555,21 @@ fn write_unchanged(
         ));
     }
     let searched = more.as_ref().is_some_and(|f| !f.added.is_empty());
-    let explanation = match (auto, what) {
-        _ if again.is_some() => again.as_ref().map_or("", |a| a.rep.explanation.as_str()),
-        (true, Written::Augmented) if !searched => {
-            "diagnose found no missing effect; the model written is the reference model with \
-             the steering-gear dynamics the reference records show of their own"
-        }
-        (true, Written::Input) => "diagnose found no missing effect; the model is kept as it is",
-        (true, _) => "diagnose found no missing effect",
-        (false, _) => "no effect named",
+    // `augmented` with no effect kept: the ship's own physics the base carries
+    let own = if auto && what == Written::Augmented && !searched {
+        " The model written is `augmented` against the model given: it carries the ship's \
+         own physics the reference records show."
+    } else {
+        ""
+    };
+    let explanation = match (&again, auto) {
+        (Some(a), _) if a.kind.is_some() => format!("{}{own}", a.rep.explanation),
+        (Some(a), _) => format!(
+            "diagnose found no missing effect. {}{own}",
+            a.rep.explanation
+        ),
+        (None, true) => format!("diagnose found no missing effect.{own}"),
+        (None, false) => "no effect named".to_string(),
     };
     let fits = |f: &BTreeMap<String, f64>| FitSummary { fit: f.clone() };
     let gain = again.as_ref().map_or(0.0, |a| {
@@ -545,9 +583,11 @@ fn write_unchanged(
         &args.json,
         &serde_json::json!({
             "command": "augment",
-            "effect": again.as_ref().map_or("none", |a| a.kind.name()),
+            "effect": again.as_ref().and_then(|a| a.kind).map_or("none", |k| k.name()),
             "auto": auto,
-            "kept": again.as_ref().is_some_and(|a| a.rep.written != Written::Input),
+            "kept": again
+                .as_ref()
+                .is_some_and(|a| a.kind.is_some() && a.rep.written != Written::Input),
             "written": what,
             "before": again.as_ref().map(|a| fits(&a.rep.before)),
             "after": again.as_ref().map(|a| fits(&a.rep.after)),

@@ -11,6 +11,7 @@ pub(super) const DEF: Def = Def {
     kind: EffectKind::Asymmetry,
     phrase: "a port/starboard steering asymmetry",
     role: Role::Regressor,
+    own: true,
     channel: Channel::None,
     slow: false,
     gains: &[("beta", Regressor::Starboard)],

@@ -14,6 +14,7 @@ pub(super) const DEF: Def = Def {
     kind: EffectKind::Bias,
     phrase: "a constant yaw moment",
     role: Role::Regressor,
+    own: false,
     channel: Channel::None,
     slow: true,
     gains: &[("beta", Regressor::One)],

@@ -14,6 +14,7 @@ pub(super) const DEF: Def = Def {
     kind: EffectKind::Current,
     phrase: "a current",
     role: Role::Regressor,
+    own: false,
     channel: Channel::SpeedOverGround,
     slow: true,
     gains: &[("beta_s", Regressor::Sin1), ("beta_c", Regressor::Cos1)],

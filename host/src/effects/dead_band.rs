@@ -12,6 +12,7 @@ pub(super) const DEF: Def = Def {
     kind: EffectKind::DeadBand,
     phrase: "a steering-gear dead band",
     role: Role::Actuator { dynamics: false },
+    own: true,
     channel: Channel::None,
     slow: false,
     gains: &[],

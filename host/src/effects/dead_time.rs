@@ -10,6 +10,7 @@ pub(super) const DEF: Def = Def {
     kind: EffectKind::DeadTime,
     phrase: "a command dead time",
     role: Role::Actuator { dynamics: true },
+    own: true,
     channel: Channel::None,
     slow: false,
     gains: &[],

@@ -109,6 +109,14 @@ pub struct Def {
     pub phrase: &'static str,
     /// Where it enters the model.
     pub role: Role,
+    /// Physics of the ship's own, present on every record it sails, that a linear model
+    /// lacks and the reference records can show: `augment --effect auto` adds what they
+    /// show ([`crate::diagnose::augment::own_base`]) — the hull's nonlinear damping, a
+    /// rudder asymmetry, the gear's limits and dynamics (the dynamics from diagnose). Not
+    /// the day's wind, current, steady moment or sensor offset. On a hull whose turn grows
+    /// less than linearly with the angle an angle limit re-identified on the reference
+    /// stands for that hull physics, and the words say so.
+    pub own: bool,
     /// The channel besides the yaw rate that shows it.
     pub channel: Channel,
     /// Judged on the long-horizon errors (a slow, steady effect) rather than the one-step

@@ -12,6 +12,7 @@ pub(super) const DEF: Def = Def {
     kind: EffectKind::GyroBias,
     phrase: "a rate-gyro offset",
     role: Role::Output,
+    own: false,
     channel: Channel::Heading,
     slow: true,
     gains: &[("d_y", Regressor::Offset)],

@@ -11,6 +11,7 @@ pub(super) const DEF: Def = Def {
     kind: EffectKind::NonlinearDamping,
     phrase: "extra nonlinear yaw damping",
     role: Role::Regressor,
+    own: true,
     channel: Channel::None,
     slow: false,
     gains: &[("beta", Regressor::Damping)],

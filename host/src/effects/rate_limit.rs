@@ -16,6 +16,7 @@ pub(super) const DEF: Def = Def {
     kind: EffectKind::RateLimit,
     phrase: "a rudder/pod slew-rate limit",
     role: Role::Actuator { dynamics: true },
+    own: true,
     channel: Channel::None,
     slow: false,
     gains: &[],

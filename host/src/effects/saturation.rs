@@ -12,6 +12,7 @@ pub(super) const DEF: Def = Def {
     phrase: "a rudder/pod angle limit",
     // static: θ cannot absorb it (it changes the gain at large angles, not the dynamics)
     role: Role::Actuator { dynamics: false },
+    own: true,
     channel: Channel::None,
     slow: false,
     gains: &[],

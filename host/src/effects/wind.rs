@@ -14,6 +14,7 @@ pub(super) const DEF: Def = Def {
     kind: EffectKind::Wind,
     phrase: "a heading-dependent wind moment",
     role: Role::Regressor,
+    own: false,
     channel: Channel::SpeedOverGround,
     slow: true,
     gains: &[

@@ -84,9 +84,9 @@ mod simulator;
 pub(crate) mod tests;
 mod words;
 
-pub use again::{reestimate, Reestimated};
+pub use again::{reestimate, refit, Reestimated, Refitted};
 pub use agree::{check_estimate, EstimateCheck};
-pub use auto::{gear_base, GearBase};
+pub use auto::{own_base, OwnBase};
 pub use forward::{forward, forward_ranked, ForwardReport, Round, Tried};
 pub use judge::{HeldOutGain, Reason};
 pub use simulator::to_sim_effect;
