@@ -284,61 +284,33 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
             (kind, true, model, then, parameter)
         }
     };
-    let Some(kind) = kind else {
-        if !auto {
-            return write_unchanged(args, outputs, &given, &model, &est, &val, auto, &cfg, None);
-        }
-        // nothing missing, but the trials are the ship's own records: the structure is
-        // re-identified on them and judged as augment judges a model without an added effect
-        let rep = augment::refit(&model, &est, &val, &cfg).map_err(cli_err)?;
-        println!("{}", rep.explanation);
-        let model = rep.model.clone();
-        let again = Again {
+    // `--effect auto` adding nothing: the verdict `none` (the structure re-identified on the
+    // trials, which are the ship's own records) or an effect the model carries (diagnose
+    // tested it for a change: re-estimated, not added twice)
+    let again = match kind {
+        None if auto => Some(Again {
             kind: None,
-            rep,
+            rep: augment::refit(&model, &est, &val, &cfg).map_err(cli_err)?,
             then: None,
-        };
-        return write_unchanged(
-            args,
-            outputs,
-            &given,
-            &model,
-            &est,
-            &val,
-            auto,
-            &cfg,
-            Some(again),
-        );
-    };
-    if auto && model.effect(kind).is_some() {
-        // diagnose tested the model's own effect for a change: re-estimate it, do not add it
-        let r = augment::reestimate(&model, kind, &est, &val, &cfg).map_err(cli_err)?;
-        println!("{}", r.explanation);
-        let rep = augment::Refitted {
-            model: r.model,
-            written: r.written,
-            before: r.before,
-            after: r.after,
-            explanation: r.explanation,
-        };
-        let again = Again {
-            kind: Some(kind),
-            rep,
+        }),
+        Some(k) if auto && model.effect(k).is_some() => Some(Again {
+            kind: Some(k),
+            rep: augment::reestimate(&model, k, &est, &val, &cfg)
+                .map_err(cli_err)?
+                .refit,
             then,
-        };
-        let model = again.rep.model.clone();
-        return write_unchanged(
-            args,
-            outputs,
-            &given,
-            &model,
-            &est,
-            &val,
-            auto,
-            &cfg,
-            Some(again),
-        );
-    }
+        }),
+        _ => None,
+    };
+    let (Some(kind), None) = (kind, &again) else {
+        if let Some(a) = &again {
+            println!("{}", a.rep.explanation);
+        }
+        let model = again
+            .as_ref()
+            .map_or(model.clone(), |a| a.rep.model.clone());
+        return write_unchanged(args, outputs, &given, &model, &est, &val, auto, &cfg, again);
+    };
     let t0 = std::time::Instant::now();
     let rep = augment::augment(&model, kind, &est, &val, &cfg).map_err(cli_err)?;
     print_report(&rep, t0.elapsed().as_secs_f64());

@@ -670,3 +670,75 @@ fn augment_auto_states_the_damping_in_the_form_diagnose_measured() {
     );
     assert!(a < 0.0 && g < 0.0 && a / g > 0.5 && a / g < 2.0, "{c}");
 }
+
+#[test]
+fn augment_auto_on_effect_free_trials_writes_the_ships_own_physics_refitted() {
+    // nothing missing on the trials: the model written is the reference model with the
+    // hull's own damping the reference records show, re-identified on the trials when that
+    // validates better; `written` and `effects` describe the file, and the text says why it
+    // is `augmented` with no effect kept (before, the reference model was written as it was)
+    let d = scratch("auto-none");
+    let reference = sim_csvs(&d, "ref", None, &[611, 612, 613]);
+    let model = model_from(&d, &reference);
+    let est = sim_csvs(&d, "trial", None, &[71, 72, 73]);
+    let (out, json) = (d.join("aug"), d.join("aug-summary.json"));
+    let mut args: Vec<String> = ["augment", "--model", &model.display().to_string()]
+        .map(String::from)
+        .to_vec();
+    args.extend(["--effect", "auto", "--seed", "1"].map(String::from));
+    for r in &reference {
+        args.extend(["--reference".into(), r.display().to_string()]);
+    }
+    for t in &est {
+        args.extend(["--data".into(), t.display().to_string()]);
+    }
+    args.extend(["--out".into(), out.display().to_string()]);
+    args.extend(["--json".into(), json.display().to_string()]);
+    let o = run(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(code(&o), 0, "{}\n{}", stdout(&o), stderr(&o));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["effect"], "none", "{}", stdout(&o));
+    assert_eq!(v["kept"], false);
+    assert!(
+        stdout(&o).contains("augmenting the reference model with the ship's own physics"),
+        "{}",
+        stdout(&o)
+    );
+    // the file written carries what `effects` says, the hull's damping among them
+    let twin: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("aug.json")).unwrap()).unwrap();
+    let in_file: Vec<&serde_json::Value> = twin["model"]["effects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| &e["effect"])
+        .collect();
+    let said: Vec<&serde_json::Value> = v["effects"].as_array().unwrap().iter().collect();
+    assert_eq!(in_file, said);
+    assert!(
+        said.contains(&&serde_json::json!("nonlinear-damping")),
+        "{said:?}"
+    );
+    assert_eq!(v["written"], "augmented");
+    let why = v["explanation"].as_str().unwrap();
+    assert!(
+        why.starts_with("diagnose found no missing effect."),
+        "{why}"
+    );
+    assert!(why.contains("it carries the ship's own physics"), "{why}");
+    // re-identified on the trials: its held-out 10-step fit against the unrefitted model's,
+    // and the gain reported is their difference when the refit is written
+    let (b10, a10) = (
+        v["before"]["fit"]["10"].as_f64().unwrap(),
+        v["after"]["fit"]["10"].as_f64().unwrap(),
+    );
+    let refitted = why.contains("The model written is the input structure re-identified");
+    let gain = v["fit_gain_pp"].as_f64().unwrap();
+    if refitted {
+        assert!(a10 > b10, "{b10} → {a10}");
+        assert!((gain - (a10 - b10)).abs() < 1e-9, "{gain}");
+    } else {
+        assert_eq!(gain, 0.0);
+    }
+}

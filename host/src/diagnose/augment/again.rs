@@ -15,22 +15,13 @@ use crate::io::data::Record;
 /// What [`reestimate`] found.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Reestimated {
-    /// The model to write: the input structure re-identified on the estimation records (the
-    /// effect's value re-estimated with the rest) when it validates better than the input
-    /// model at 10 steps and no worse in simulation, else the input model.
-    pub model: Model,
-    /// Which of the two.
-    pub written: Written,
+    /// The model written and why ([`refit`]'s rule); its explanation gives both values of
+    /// the effect.
+    pub refit: Refitted,
     /// The effect as the model given carries it.
     pub given: Effect,
     /// The effect in the re-identified structure.
     pub reestimated: Effect,
-    /// Held-out fit % of the input model, keyed by horizon.
-    pub before: BTreeMap<String, f64>,
-    /// Held-out fit % of the re-identified structure.
-    pub after: BTreeMap<String, f64>,
-    /// In words, with both values and the fits.
-    pub explanation: String,
 }
 
 /// Re-estimates the effect `kind` that `model` carries on the records `est`, judged on `val`
@@ -60,7 +51,7 @@ pub struct Reestimated {
 /// };
 /// let r = reestimate(&given, EffectKind::Bias, &[rec(1), rec(2)], &[rec(3)],
 ///                    &AugmentConfig::default()).unwrap();
-/// assert_eq!(r.written, Written::Refit);
+/// assert_eq!(r.refit.written, Written::Refit);
 /// let Effect::Bias { beta } = r.reestimated else { panic!() };
 /// assert!((beta - 1.0).abs() < 0.1, "{beta}");
 /// ```
@@ -75,8 +66,8 @@ pub fn reestimate(
     let given = *model.effect(kind).ok_or(AugmentError::Absent(kind))?;
     let prep = prepare(model, est, val, cfg)?;
     let reestimated = prep.base.model.effect(kind).copied().unwrap_or(given);
-    let r = judged(model, est, &prep, cfg);
-    let explanation = format!(
+    let mut r = judged(model, est, &prep, cfg);
+    r.explanation = format!(
         "The model carries {} already and the trials show it changed: re-identified on them \
          with the rest of the structure it is {}. {}",
         given.describe(model.ts),
@@ -84,13 +75,9 @@ pub fn reestimate(
         r.explanation,
     );
     Ok(Reestimated {
-        model: r.model,
-        written: r.written,
+        refit: r,
         given,
         reestimated,
-        before: r.before,
-        after: r.after,
-        explanation,
     })
 }
 
