@@ -627,26 +627,8 @@ fn augment_auto_states_the_damping_in_the_form_diagnose_measured() {
     let model = model_from(&d, &reference);
     let damping = SimEffect::hidden(EffectKind::NonlinearDamping, 1.0);
     let est = sim_csvs(&d, "trial", Some(damping), &[61, 62, 63]);
-    let (out, json) = (d.join("aug"), d.join("aug-summary.json"));
-    let mut args: Vec<String> = ["augment", "--model", &model.display().to_string()]
-        .map(String::from)
-        .to_vec();
-    args.extend(["--effect", "auto", "--seed", "1"].map(String::from));
-    for r in &reference {
-        args.extend(["--reference".into(), r.display().to_string()]);
-    }
-    for t in &est {
-        args.extend(["--data".into(), t.display().to_string()]);
-    }
-    args.extend(["--out".into(), out.display().to_string()]);
-    args.extend(["--json".into(), json.display().to_string()]);
-    let o = run(&args.iter().map(String::as_str).collect::<Vec<_>>());
-    assert_eq!(code(&o), 0, "{}\n{}", stdout(&o), stderr(&o));
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let (o, v, twin) = augment_auto(&d, &model, &reference, &est);
     assert_eq!(v["effect"], "nonlinear-damping", "{}", stdout(&o));
-    let twin: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(d.join("aug.json")).unwrap()).unwrap();
     let written = twin["model"]["effects"]
         .as_array()
         .unwrap()
@@ -681,23 +663,7 @@ fn augment_auto_on_effect_free_trials_writes_the_ships_own_physics_refitted() {
     let reference = sim_csvs(&d, "ref", None, &[611, 612, 613]);
     let model = model_from(&d, &reference);
     let est = sim_csvs(&d, "trial", None, &[71, 72, 73]);
-    let (out, json) = (d.join("aug"), d.join("aug-summary.json"));
-    let mut args: Vec<String> = ["augment", "--model", &model.display().to_string()]
-        .map(String::from)
-        .to_vec();
-    args.extend(["--effect", "auto", "--seed", "1"].map(String::from));
-    for r in &reference {
-        args.extend(["--reference".into(), r.display().to_string()]);
-    }
-    for t in &est {
-        args.extend(["--data".into(), t.display().to_string()]);
-    }
-    args.extend(["--out".into(), out.display().to_string()]);
-    args.extend(["--json".into(), json.display().to_string()]);
-    let o = run(&args.iter().map(String::as_str).collect::<Vec<_>>());
-    assert_eq!(code(&o), 0, "{}\n{}", stdout(&o), stderr(&o));
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let (o, v, twin) = augment_auto(&d, &model, &reference, &est);
     assert_eq!(v["effect"], "none", "{}", stdout(&o));
     assert_eq!(v["kept"], false);
     assert!(
@@ -706,8 +672,6 @@ fn augment_auto_on_effect_free_trials_writes_the_ships_own_physics_refitted() {
         stdout(&o)
     );
     // the file written carries what `effects` says, the hull's damping among them
-    let twin: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(d.join("aug.json")).unwrap()).unwrap();
     let in_file: Vec<&serde_json::Value> = twin["model"]["effects"]
         .as_array()
         .unwrap()
@@ -741,4 +705,33 @@ fn augment_auto_on_effect_free_trials_writes_the_ships_own_physics_refitted() {
     } else {
         assert_eq!(gain, 0.0);
     }
+}
+
+/// `augment --effect auto --seed 1` of `model` on the trials `est` against `reference`,
+/// written to `dir/aug`: its output, its `--json` report and the written model's JSON twin.
+fn augment_auto(
+    dir: &Path,
+    model: &Path,
+    reference: &[PathBuf],
+    est: &[PathBuf],
+) -> (std::process::Output, serde_json::Value, serde_json::Value) {
+    let (out, json) = (dir.join("aug"), dir.join("aug-summary.json"));
+    let mut args: Vec<String> = ["augment", "--model", &model.display().to_string()]
+        .map(String::from)
+        .to_vec();
+    args.extend(["--effect", "auto", "--seed", "1"].map(String::from));
+    for r in reference {
+        args.extend(["--reference".into(), r.display().to_string()]);
+    }
+    for t in est {
+        args.extend(["--data".into(), t.display().to_string()]);
+    }
+    args.extend(["--out".into(), out.display().to_string()]);
+    args.extend(["--json".into(), json.display().to_string()]);
+    let o = run(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(code(&o), 0, "{}\n{}", stdout(&o), stderr(&o));
+    let read = |p: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+    };
+    (o, read(&json), read(&dir.join("aug.json")))
 }
