@@ -55,7 +55,8 @@ work="$repo/target/bench-worlds"
 worlds="lng,kvlcc2,mariner"
 seeds=3
 strengths="1,0.5"
-effects="none,bias,gyro-bias,dead-time,rate-limit,saturation,asymmetry,nonlinear-damping,wind,current,dead-band"
+effects="none,bias,gyro-bias,dead-time,rate-limit,saturation,asymmetry,nonlinear-damping"
+effects="$effects,wind,current,dead-band"
 jobs=2
 logwind=""
 augment=0
@@ -183,7 +184,8 @@ print(f"{o:.2f}/{max(l, r):.2f}/{a:.2f}/{m:.2f}")' "$o" "$l" "$r" "$a" "$mo")
             fi
         fi
     fi
-    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$world" "$strength" "$effect" "$seed" "$verdict" "$augmented" "$fits"
+    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$world" "$strength" "$effect" "$seed" \
+        "$verdict" "$augmented" "$fits"
 }
 export -f case_run
 
@@ -246,7 +248,8 @@ if pairs:
     print("| world | strength | pair | cases both named | first two named |"
           + (" both in the model augment --more writes | its effects |" if aug else ""))
     print("|---|---|---|---|---|" + ("---|---|" if aug else ""))
-    for r0 in sorted({(r[0], r[1], r[2]) for r in pairs}, key=lambda k: (worlds.index(k[0]), -float(k[1]), k[2])):
+    for r0 in sorted({(r[0], r[1], r[2]) for r in pairs},
+                     key=lambda k: (worlds.index(k[0]), -float(k[1]), k[2])):
         cs = [r for r in pairs if (r[0], r[1], r[2]) == r0]
         both = sum(set(r[2].split("+")) <= set(r[4].split("+")) for r in cs)
         line = f"| {r0[0]} | {r0[1]} | {r0[2]} | {both}/{len(cs)} | {', '.join(r[4] for r in cs)} |"
@@ -258,7 +261,8 @@ if pairs:
 if not rows:
     sys.exit(0)
 aug1 = any(r[6] != "-" for r in rows)
-print("| world | strength | effect cases right | false alarms (effect-free) | effects right in ≥ 2 of 3 seeds | a second effect named |"
+print("| world | strength | effect cases right | false alarms (effect-free) |"
+      " effects right in ≥ 2 of 3 seeds | a second effect named |"
       + (" effect in the model augment --more writes |" if aug1 else ""))
 print("|---|---|---|---|---|---|" + ("---|" if aug1 else ""))
 for w in worlds:
@@ -275,7 +279,8 @@ for w in worlds:
         extra = ""
         if aug1:
             extra = f" {sum(r[2] in accounted(r[6]) for r in eff)}/{len(eff)} |"
-        print(f"| {w} | {st} | {right}/{len(eff)} | {alarms}/{len(nulls)} | {good}/{len(by)} | {seconds}/{len(eff)} |" + extra)
+        print(f"| {w} | {st} | {right}/{len(eff)} | {alarms}/{len(nulls)} | {good}/{len(by)} |"
+              f" {seconds}/{len(eff)} |" + extra)
 won = [r for r in rows if len(r) > 7 and r[7] not in ("-", "error") and r[2] != "none"]
 if won:
     import math, statistics
@@ -283,13 +288,15 @@ if won:
         """oracle, best linear, augment --effect auto, and --more (None in older runs)."""
         v = list(map(float, r[7].split("/")))
         return tuple(v + [None] * (4 - len(v)))
-    print("\n## Error won back at 10 steps (validation record; oracle = the world's own predictor)\n")
+    print("\n## Error won back at 10 steps (validation record; oracle = the world's own "
+          "predictor)\n")
     print("Loss = oracle − best linear; won back = (augmented − linear) / loss over the cases "
           "whose loss is ≥ 3 pp. Net: the loss less the world's own gap on effect-free trials "
           "(median oracle − linear of its `none` cases: the hull's nonlinearity and the state "
           "the oracle knows and a model must estimate), over the cases whose net loss is ≥ 3 pp. "
           "With --more: the model `augment --effect auto --more` writes, over the same cases.\n")
-    print("| world | strength | cases | loss ≥ 3 pp | median loss (pp) | median won back | ≥ 60 % |"
+    print("| world | strength | cases | loss ≥ 3 pp | median loss (pp) | median won back |"
+          " ≥ 60 % |"
           " effect-free gap (pp) | net loss ≥ 3 pp | median won back of the net loss | ≥ 60 % |"
           " median won back with --more | ≥ 60 % |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
@@ -327,7 +334,8 @@ if won:
     print("\nPer case (oracle / best linear / augment --effect auto / with --more, fit % at 10 "
           "steps):\n")
     for w in worlds:
-        for st in sorted({r[1] for r in rows if r[0] == w and len(r) > 7 and r[7] != "-"}, key=float, reverse=True):
+        for st in sorted({r[1] for r in rows if r[0] == w and len(r) > 7 and r[7] != "-"},
+                         key=float, reverse=True):
             print(f"- {w}, strength {st}: " + "; ".join(f"{r[2]} s{r[3]} {r[7]}" for r in rows
                   if r[0] == w and (r[1] == st or r[2] == "none") and len(r) > 7 and r[7] != "-"))
 print("\n## Verdicts per case (hidden → named)\n")
