@@ -534,14 +534,14 @@ fn write_unchanged(
     } else {
         ""
     };
-    let explanation = match (&again, auto) {
-        (Some(a), _) if a.kind.is_some() => format!("{}{own}", a.rep.explanation),
-        (Some(a), _) => format!(
+    // (`--effect auto` always comes with `again`: without it, no effect was named)
+    let explanation = match &again {
+        Some(a) if a.kind.is_some() => format!("{}{own}", a.rep.explanation),
+        Some(a) => format!(
             "diagnose found no missing effect. {}{own}",
             a.rep.explanation
         ),
-        (None, true) => format!("diagnose found no missing effect.{own}"),
-        (None, false) => "no effect named".to_string(),
+        None => "no effect named".to_string(),
     };
     let fits = |f: &BTreeMap<String, f64>| FitSummary { fit: f.clone() };
     let gain = again.as_ref().map_or(0.0, |a| {
