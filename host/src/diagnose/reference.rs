@@ -57,11 +57,7 @@ pub(super) fn reference_actuator(
     if f.added.is_empty() || !f.model.is_stable() {
         return None;
     }
-    let first = f.rounds.first().and_then(|r| r.added.as_ref())?;
-    let (without, with) = (
-        first.baseline.get("10").copied().unwrap_or(f64::NAN),
-        f.after.get("10").copied().unwrap_or(f64::NAN),
-    );
+    let (without, with) = f.fit10_without_and_with()?;
     let own: Vec<String> = f
         .added
         .iter()

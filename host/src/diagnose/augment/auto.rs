@@ -122,15 +122,8 @@ pub fn own_base(
         .filter(|f| !f.added.is_empty() && f.model.is_stable());
     let (mut model, held_out) = match searched {
         Some(f) => {
-            let fit10 = |m: &std::collections::BTreeMap<String, f64>| {
-                m.get("10").copied().unwrap_or(f64::NAN)
-            };
-            let without = f
-                .rounds
-                .first()
-                .and_then(|r| r.added.as_ref())
-                .map_or(f64::NAN, |a| fit10(&a.baseline));
-            (f.model, Some((without, fit10(&f.after))))
+            let fits = f.fit10_without_and_with();
+            (f.model, fits)
         }
         None => (start, None),
     };

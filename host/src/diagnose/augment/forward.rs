@@ -68,6 +68,17 @@ pub struct ForwardReport {
     pub explanation: String,
 }
 
+impl ForwardReport {
+    /// Held-out 10-step fit % of the structure the first round re-identified without any
+    /// added effect, and of the returned model (NaN where missing); `None` when nothing was
+    /// added.
+    pub fn fit10_without_and_with(&self) -> Option<(f64, f64)> {
+        let first = self.rounds.first().and_then(|r| r.added.as_ref())?;
+        let fit10 = |m: &BTreeMap<String, f64>| m.get("10").copied().unwrap_or(f64::NAN);
+        Some((fit10(&first.baseline), fit10(&self.after)))
+    }
+}
+
 fn ser_kinds<S: Serializer>(k: &[EffectKind], s: S) -> Result<S::Ok, S::Error> {
     s.collect_seq(k.iter().map(|k| k.name()))
 }
