@@ -789,6 +789,19 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
     current_or_wind(&mut ev, level, alpha, true, Some(0.5));
     assert_eq!(kinds(&ev), [EffectKind::Current, EffectKind::Wind]);
     assert!(current_or_leeway(&ev).is_none());
+    // an anemometer showing no wind outranks a yaw moment varying with heading: the
+    // built-in ship's effect-free ±20° zig-zags against its PRBS reference (seed 2) read
+    // as wind at p 7.4e-5 from the yaw channel alone, the anemometer's true wind 0.00 m/s
+    // at p 1, the current not significant
+    let mut ev = vec![
+        evidence(EffectKind::Wind, 7.4e-5, 2.5e-5, true),
+        evidence(EffectKind::Current, 1.0, 0.3, false),
+    ];
+    current_or_wind(&mut ev, level, alpha, true, Some(1.0));
+    assert_eq!(kinds(&ev), [EffectKind::Current, EffectKind::Wind]);
+    assert_eq!(ev[1].p, 1.0);
+    assert!(!ev[1].channel_material);
+    assert!(ev[1].words.contains("(absent)"), "{}", ev[1].words);
     // without speed over ground, or with neither significant, nothing changes
     for (speed, p) in [(false, 1e-7), (true, 0.5)] {
         let mut ev = vec![

@@ -164,7 +164,9 @@ pub(super) fn rank(
 /// this test names is ranked ahead of the other; wind named this way is significant when
 /// both the heading dependence (the better of the two effects' p-values) and the yaw moment
 /// are (intersection–union: the larger p-value), and material when the speed channel shows
-/// the heading dependence.
+/// the heading dependence. Where an anemometer decides and shows no wind, wind is not
+/// significant (its p at least the anemometer's): the instrument that measures the wind
+/// outranks a yaw moment that may be anything varying with heading.
 pub(super) fn current_or_wind(
     ev: &mut Vec<Evidence>,
     level: f64,
@@ -218,6 +220,12 @@ pub(super) fn current_or_wind(
         let w = &mut ev[iw];
         w.p = w.p.min(heading_p.max(p_decide));
         w.channel_material |= cm;
+    } else if anemometer.is_some() {
+        // the anemometer shows no wind: a yaw moment varying with heading is then not the
+        // wind's, whatever its own p (on zig-zags the hull's own moment over each swing)
+        let w = &mut ev[iw];
+        w.p = w.p.max(p_decide);
+        w.channel_material = false;
     }
     let (win, lose) = if wind { (iw, ic) } else { (ic, iw) };
     if win > lose {
