@@ -90,6 +90,10 @@ pub enum Caveat {
         /// Total-variation distance between the two sets' distributions of |δ| in 1° bins
         /// (0: alike, 1: disjoint).
         distance: f64,
+        /// The hull physics of the ship's own the reference records show, which the
+        /// bootstrap's nulls then simulate on the trials' commands and the reference's
+        /// (each in words; empty when the reference shows none).
+        hull: Vec<String>,
     },
     /// A significant effect that does not improve held-out prediction was named behind
     /// the verdict by the ranking rule.
@@ -198,15 +202,32 @@ impl Caveat {
                  PRBS, or zig-zags of two amplitudes).",
                 100.0 * share
             ),
-            Caveat::OtherManoeuvre { distance } => format!(
-                "The trials were sailed with other commands than the reference ({:.0} % of \
-                 their command magnitudes lie where the reference's do not, 1° bins): a linear \
-                 model meets the hull's own nonlinearity differently on other commands, and the \
-                 reference's own spread, which the statistics are judged against, does not \
-                 measure that. An actuator or hull effect named may be the hull's own; sail \
-                 the reference with the trials' manoeuvre.",
-                100.0 * distance
-            ),
+            Caveat::OtherManoeuvre { distance, hull } => {
+                let nulls = if hull.is_empty() {
+                    "The reference records show no hull physics of their own that the null \
+                     distributions could simulate on the trials' commands, and the \
+                     reference's own spread, which the statistics are also judged against, \
+                     does not measure that."
+                        .to_string()
+                } else {
+                    format!(
+                        "So the null distributions simulate the hull physics the reference \
+                         records show of their own ({}, re-identified on the reference) on the \
+                         trials' commands as well as the reference's; what that physics does \
+                         not capture of the hull at the trials' commands can still read as an \
+                         effect.",
+                        hull.join(", ")
+                    )
+                };
+                format!(
+                    "The trials were sailed with other commands than the reference ({:.0} % of \
+                     their command magnitudes lie where the reference's do not, 1° bins): a \
+                     linear model meets the hull's own nonlinearity differently on other \
+                     commands. {nulls} An actuator or hull effect named may be the hull's own; \
+                     sail the reference with the trials' manoeuvre.",
+                    100.0 * distance
+                )
+            }
             Caveat::PassedOver { effect } => {
                 let kind = EffectKind::from_name(effect);
                 format!(

@@ -121,8 +121,8 @@ const OTHER_MANOEUVRE: f64 = 0.5;
 
 /// The caveat for trials sailed with other commands than the reference's
 /// ([`Caveat::OtherManoeuvre`]): the total-variation distance between the two sets'
-/// distributions of |δ| in 1° bins, given from [`OTHER_MANOEUVRE`] on; `None` without a
-/// reference.
+/// distributions of |δ| in 1° bins, given from [`OTHER_MANOEUVRE`] on (with no `hull`:
+/// the driver adds what the nulls simulate); `None` without a reference.
 pub(super) fn other_manoeuvre(est: &[Record], reference: &[Record]) -> Option<Caveat> {
     let hist = |recs: &[Record]| -> (BTreeMap<i64, f64>, f64) {
         let mut h: BTreeMap<i64, f64> = BTreeMap::new();
@@ -148,7 +148,10 @@ pub(super) fn other_manoeuvre(est: &[Record], reference: &[Record]) -> Option<Ca
                 (f(&ht, nt) - f(&hr, nr)).abs()
             })
             .sum::<f64>();
-    (distance >= OTHER_MANOEUVRE).then_some(Caveat::OtherManoeuvre { distance })
+    (distance >= OTHER_MANOEUVRE).then_some(Caveat::OtherManoeuvre {
+        distance,
+        hull: Vec::new(),
+    })
 }
 
 #[cfg(test)]
@@ -306,15 +309,34 @@ mod tests {
         // the zig-zag against the PRBS: three quarters of its magnitudes (20°, 290 of 300
         // samples, against a quarter of the PRBS's) lie where the PRBS's do not
         let c = other_manoeuvre(&[rec(zz.clone())], &[rec(prbs.clone())]).unwrap();
-        let Caveat::OtherManoeuvre { distance } = c else {
+        let Caveat::OtherManoeuvre { distance, .. } = c else {
             panic!("{c:?}")
         };
         let want = 0.5 * ((290.0 / 300.0 - 0.25) + 10.0 / 300.0 + 3.0 * 0.25);
         assert!((distance - want).abs() < 1e-12, "{distance} vs {want}");
         assert!(c.explain().contains("(75 % of"), "{}", c.explain());
+        let json = serde_json::to_value(&c).unwrap();
+        assert_eq!(json["caveat"], "other-manoeuvre");
+        assert_eq!(json["hull"], serde_json::json!([]));
+        assert!(
+            c.explain().contains("show no hull physics"),
+            "{}",
+            c.explain()
+        );
+        // with the hull physics the nulls simulated, named in the field and the words
+        let with = Caveat::OtherManoeuvre {
+            distance,
+            hull: vec!["extra yaw damping".into()],
+        };
         assert_eq!(
-            serde_json::to_value(&c).unwrap()["caveat"],
-            "other-manoeuvre"
+            serde_json::to_value(&with).unwrap()["hull"][0],
+            "extra yaw damping"
+        );
+        assert!(
+            with.explain()
+                .contains("records show of their own (extra yaw damping, re-identified"),
+            "{}",
+            with.explain()
         );
         // alike: none; no reference: none
         assert!(other_manoeuvre(&[rec(zz.clone())], &[rec(zz.clone())]).is_none());

@@ -32,6 +32,14 @@
 //!   variance on the reference and trial inputs; `D` is recomputed on each replicate and a
 //!   scaled χ² is fitted to the replicates (Satterthwaite), which gives the p-value. No
 //!   threshold is set by hand: an effect is *significant* at level α.
+//! - **Trials sailed with other commands.** Where half or more of the trials' command
+//!   magnitudes lie where the reference's do not (a zig-zag against a PRBS), the linear
+//!   model meets the hull's own nonlinearity differently on the two, which data simulated
+//!   from a linear model cannot show. The hull physics the reference records show of their
+//!   own ([`crate::diagnose::augment::forward`] over the registry's `own` kinds on the
+//!   reference, with its gear) is then what the bootstrap simulates, with its own
+//!   innovation variance, on both sets' commands; the linear structure is still what each
+//!   replicate re-identifies and measures `D` against.
 //! - **The reference's own spread.** For an effect with no free gain (dead time, gear rate,
 //!   angle limit, dead band) data from the linear model can only fit worse, so the
 //!   bootstrap's replicates are (almost) all 0 and say nothing of how far two effect-free
@@ -118,7 +126,7 @@ use caveat::caveats;
 use channels::Channels;
 use evidence::{grid, reference_versions, trial_stats, Set};
 use null::bootstrap;
-use reference::{foreign, reference_actuator};
+use reference::{foreign, reference_actuator, reference_hull};
 use rule::{gain_before_statistic, outpredicted, yaw_before_speed};
 use verdict::{cfg_m, effect_evidence, frozen_gain, rank, ranked, split, verdict_words, Evidence};
 
@@ -393,8 +401,27 @@ pub fn diagnose(
     let real = trial_stats(base, est, &grids, &versions, cfg.parallel);
     bar.inc(1);
     bar.set_message("bootstrap replicates");
+    // trials sailed with other commands than the reference: the nulls simulate the hull
+    // physics the reference shows of its own, on both sets' commands (module docs)
+    let mut other = commands::other_manoeuvre(est, reference);
+    let hull = other
+        .as_ref()
+        .and_then(|_| reference_hull(base, reference, cfg))
+        .map(|h| {
+            let (s, n) = Set::new(&h, reference).sse0(&h, 1);
+            (h, (s / n.max(1) as f64).sqrt())
+        });
+    if let (Some(Caveat::OtherManoeuvre { hull: words, .. }), Some((h, _))) = (&mut other, &hull) {
+        *words = h
+            .effects
+            .iter()
+            .filter(|e| base.effect(e.kind()).is_none())
+            .map(|e| crate::diagnose::augment::describe(e, model.ts))
+            .collect();
+    }
     let boot = bootstrap(
         base,
+        hull.as_ref().map(|(h, s)| (h, *s)),
         reference,
         est,
         &grids,
@@ -550,7 +577,7 @@ pub fn diagnose(
     caveats.extend(commands::clip_or_dead_band(&named, est));
     caveats.extend(commands::asymmetry_or_bias(&named, est));
     caveats.extend(commands::slew_or_dead_time(&named, est));
-    caveats.extend(commands::other_manoeuvre(est, reference));
+    caveats.extend(other);
     let then = then.map(|(e, _)| e.kind.name().to_string());
     if then.as_deref() == Some(EffectKind::Current.name()) {
         // a current named second: what speed over ground cannot show does not qualify it

@@ -83,10 +83,14 @@ impl Null {
 /// Null replicates of `D` for every kind: parametric bootstrap of the whole procedure. The
 /// innovations model is simulated with its innovation std on the recorded inputs of the
 /// reference and trial records, the model is re-identified on the simulated reference (on the
-/// simulated trials when there is no reference), and `D` is recomputed.
+/// simulated trials when there is no reference), and `D` is recomputed. With a `generator`
+/// (a model and its innovation std: the hull physics the reference shows of its own, for
+/// trials sailed with other commands) that model is simulated instead, and `model`'s
+/// structure is still what each replicate re-identifies.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn bootstrap(
     model: &Model,
+    generator: Option<(&Model, f64)>,
     reference: &[Record],
     est: &[Record],
     grids: &[(EffectKind, Vec<Effect>)],
@@ -101,13 +105,14 @@ pub(super) fn bootstrap(
             seed.wrapping_mul(0x9E37_79B9_7F4A_7C15)
                 .wrapping_add(r as u64),
         );
+        let (gen, sigma) = generator.unwrap_or((model, sigma));
         let rs: Vec<Record> = reference
             .iter()
-            .map(|rec| simulate_innovations(model, rec, sigma, &mut rng))
+            .map(|rec| simulate_innovations(gen, rec, sigma, &mut rng))
             .collect();
         let ts: Vec<Record> = est
             .iter()
-            .map(|rec| simulate_innovations(model, rec, sigma, &mut rng))
+            .map(|rec| simulate_innovations(gen, rec, sigma, &mut rng))
             .collect();
         let pc = PemConfig {
             order: model.n,
