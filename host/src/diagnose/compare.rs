@@ -31,9 +31,12 @@ pub enum InputError {
     Model(#[from] ModelError),
     /// A record's sample time differs from the model's.
     #[error(
-        "record `{record}` is sampled every {found} s but the model's sample time is {expected} s"
+        "{set} record `{record}` is sampled every {found} s but the model's sample time is \
+         {expected} s"
     )]
     SampleTime {
+        /// The set it belongs to ("trial", "reference", …).
+        set: &'static str,
         /// Record name.
         record: String,
         /// The record's sample time.
@@ -42,8 +45,10 @@ pub enum InputError {
         expected: f64,
     },
     /// A record is too short for the model order or the analysis.
-    #[error("record `{record}` has {found} samples; at least {needed} are needed ({why})")]
+    #[error("{set} record `{record}` has {found} samples; at least {needed} are needed ({why})")]
     TooShort {
+        /// The set it belongs to ("trial", "reference", …).
+        set: &'static str,
         /// Record name.
         record: String,
         /// Samples found.
@@ -54,8 +59,12 @@ pub enum InputError {
         why: String,
     },
     /// Channels of a record have different lengths.
-    #[error("record `{record}`: channel `{channel}` has {found} samples, `r` has {expected}")]
+    #[error(
+        "{set} record `{record}`: channel `{channel}` has {found} samples, `r` has {expected}"
+    )]
     Ragged {
+        /// The set it belongs to ("trial", "reference", …).
+        set: &'static str,
         /// Record name.
         record: String,
         /// Offending channel.
@@ -66,8 +75,10 @@ pub enum InputError {
         expected: usize,
     },
     /// A sample is NaN or infinite.
-    #[error("record `{record}`: channel `{channel}` sample {sample} is not finite")]
+    #[error("{set} record `{record}`: channel `{channel}` sample {sample} is not finite")]
     NonFinite {
+        /// The set it belongs to ("trial", "reference", …).
+        set: &'static str,
         /// Record name.
         record: String,
         /// Channel.
@@ -120,6 +131,7 @@ pub fn check_inputs(
     for r in recs {
         if !(r.ts.is_finite() && (r.ts - model.ts).abs() <= 1e-6 * model.ts) {
             return Err(InputError::SampleTime {
+                set: what,
                 record: r.name.clone(),
                 found: r.ts,
                 expected: model.ts,
@@ -140,6 +152,7 @@ pub fn check_inputs(
         for (name, c) in &chans {
             if c.len() != n {
                 return Err(InputError::Ragged {
+                    set: what,
                     record: r.name.clone(),
                     channel: name,
                     found: c.len(),
@@ -148,6 +161,7 @@ pub fn check_inputs(
             }
             if let Some(i) = c.iter().position(|v| !v.is_finite()) {
                 return Err(InputError::NonFinite {
+                    set: what,
                     record: r.name.clone(),
                     channel: name,
                     sample: i,
@@ -156,6 +170,7 @@ pub fn check_inputs(
         }
         if n < needed {
             return Err(InputError::TooShort {
+                set: what,
                 record: r.name.clone(),
                 found: n,
                 needed,

@@ -129,6 +129,8 @@ fn bad_input_suite() {
         bad("ragged row", "identify --data {d}/ragged.csv --out {d}/out", &["ragged.csv"]),
         bad("binary garbage", "identify --data {d}/binary.csv --out {d}/out", &["binary.csv"]),
         bad("short record", "identify --data {d}/short.csv --out {d}/out", &["short.csv"]),
+        bad("short reference, diagnose", "diagnose --model {model} --data {d}/good.csv --reference {d}/short.csv --json {d}/out-summary.json", &["reference record `short`", "12 samples"]),
+        bad("short trial, diagnose", "diagnose --model {model} --data {d}/short.csv --reference {d}/good.csv --json {d}/out-summary.json", &["trial record `short`", "12 samples"]),
         bad("speed 1e9 m/s", "compare --model {model} --data {d}/speed.csv", &["speed.csv", "row 44", "u_mps"]),
         bad("wind speed −250", "compare --model {model} --data {d}/wind.csv", &["wind.csv", "row 45", "wind_speed_mps"]),
         bad(";-file with a bad cell", "compare --model {model} --data {d}/semi_bad.csv", &["semi_bad.csv", "row 1", "x"]),

@@ -72,6 +72,7 @@ pub(super) fn holdout(
         .map(|r| (r.name.clone(), r.len()))
         .unwrap_or_default();
     Err(InputError::TooShort {
+        set: "estimation",
         record: short.0,
         found: short.1,
         needed: 3 * min_part,
