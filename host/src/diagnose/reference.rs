@@ -6,7 +6,7 @@ use yawcast_shared::model::EffectKind;
 
 use super::evidence::Set;
 use super::DiagnoseConfig;
-use crate::diagnose::augment::{describe, forward, AugmentConfig};
+use crate::diagnose::augment::{describe, forward, own_search, AugmentConfig};
 use crate::effects::{def, Role};
 use crate::identify::model::Model;
 use crate::identify::pem::{self, PemConfig};
@@ -81,34 +81,15 @@ pub(super) fn reference_actuator(
 }
 
 /// The hull physics of the ship's own the reference records show, for a null that holds
-/// how the hull meets a linear model on the trials' manoeuvre: [`forward`] selection on the
-/// reference records, from `base` (the reference model with its own gear), over the kinds
-/// the registry marks as the ship's own ([`crate::effects::Def::own`]) that are not gear
-/// dynamics and that `base` lacks, each kept only when the held-out third of the reference
-/// pays for it. `None` when it keeps none.
+/// how the hull meets a linear model on the trials' manoeuvre: `augment --effect auto`'s
+/// search ([`crate::diagnose::augment::own_search`]) on the reference records, from `base`
+/// (the reference model with its own gear). `None` when it keeps none.
 pub(super) fn reference_hull(
     base: &Model,
     reference: &[Record],
     cfg: &DiagnoseConfig,
 ) -> Option<Model> {
-    let kinds: Vec<EffectKind> = EffectKind::ALL
-        .iter()
-        .copied()
-        .filter(|k| def(*k).own && def(*k).role != Role::Actuator { dynamics: true })
-        .filter(|k| base.effect(*k).is_none())
-        .collect();
-    if kinds.is_empty() || reference.is_empty() {
-        return None;
-    }
-    let acfg = AugmentConfig {
-        input_in_sample: true,
-        damping_form: None,
-        ..cfg.augment.clone()
-    };
-    forward(base, reference, &[], &kinds, &acfg)
-        .ok()
-        .filter(|f| !f.added.is_empty() && f.model.is_stable())
-        .map(|f| f.model)
+    own_search(base, reference, None, &cfg.augment).map(|f| f.model)
 }
 
 /// Is the model fitted to the trials rather than the reference? Then it has absorbed what

@@ -3,7 +3,7 @@
 
 use yawcast_shared::model::EffectKind;
 
-use super::{forward, AugmentConfig};
+use super::{forward, AugmentConfig, ForwardReport};
 use crate::effects::{def, Role};
 use crate::identify::merge::validation_fits;
 use crate::identify::model::{Effect, Model};
@@ -37,6 +37,39 @@ pub enum OwnBase {
     },
     /// The reference records show nothing of the ship's own the model given lacks.
     Nothing,
+}
+
+/// The forward selection for the ship's own physics on the reference records ([`own_base`],
+/// and diagnose's nulls for trials sailed with other commands): from `start`, over the
+/// kinds the registry marks as the ship's own ([`crate::effects::Def::own`]) that are not
+/// gear dynamics, that `start` lacks and that are not `except`, each kept only when the
+/// held-out third of the reference pays for it — judged against the structure
+/// re-identified on the first two thirds alone (the reference model saw the held-out third
+/// too), the damping in whichever form the reference favours. `None` when it keeps none,
+/// or keeps an unstable model.
+pub(crate) fn own_search(
+    start: &Model,
+    reference: &[Record],
+    except: Option<EffectKind>,
+    cfg: &AugmentConfig,
+) -> Option<ForwardReport> {
+    let kinds: Vec<EffectKind> = EffectKind::ALL
+        .iter()
+        .copied()
+        .filter(|k| def(*k).own && def(*k).role != Role::Actuator { dynamics: true })
+        .filter(|k| start.effect(*k).is_none() && except != Some(*k))
+        .collect();
+    if kinds.is_empty() || reference.is_empty() {
+        return None;
+    }
+    let acfg = AugmentConfig {
+        input_in_sample: true,
+        damping_form: None,
+        ..cfg.clone()
+    };
+    forward(start, reference, &[], &kinds, &acfg)
+        .ok()
+        .filter(|f| !f.added.is_empty() && f.model.is_stable())
 }
 
 /// The model `--effect auto` augments and why: the model given with the ship's own physics
@@ -102,24 +135,7 @@ pub fn own_base(
     let theirs = |k: EffectKind| dynamics(k) && trial_effects.contains(&k);
     let start = gear.unwrap_or_else(|| given.clone());
     let n_gear = beyond(&start).iter().filter(|e| !theirs(e.kind())).count();
-    let kinds: Vec<EffectKind> = EffectKind::ALL
-        .iter()
-        .copied()
-        .filter(|k| def(*k).own && !dynamics(*k))
-        .filter(|k| start.effect(*k).is_none() && trial_effects.first() != Some(k))
-        .collect();
-    // the reference model was identified on the whole reference, the held-out third
-    // included: the effects are judged against the structure re-identified on the first two
-    // thirds alone; the damping in whichever form the reference favours
-    let acfg = AugmentConfig {
-        input_in_sample: true,
-        damping_form: None,
-        ..cfg.clone()
-    };
-    let searched = (!kinds.is_empty() && !reference.is_empty())
-        .then(|| forward(&start, reference, &[], &kinds, &acfg).ok())
-        .flatten()
-        .filter(|f| !f.added.is_empty() && f.model.is_stable());
+    let searched = own_search(&start, reference, trial_effects.first().copied(), cfg);
     let (mut model, held_out) = match searched {
         Some(f) => {
             let fits = f.fit10_without_and_with();

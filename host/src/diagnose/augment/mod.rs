@@ -86,6 +86,7 @@ mod words;
 
 pub use again::{reestimate, refit, Reestimated, Refitted};
 pub use agree::{check_estimate, EstimateCheck};
+pub(crate) use auto::own_search;
 pub use auto::{own_base, OwnBase};
 pub use forward::{forward, forward_ranked, ForwardReport, Round, Tried};
 pub use judge::{HeldOutGain, Reason};
