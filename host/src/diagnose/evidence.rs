@@ -233,6 +233,13 @@ impl<'a> Set<'a> {
         crate::par::map(pairs, parallel, one)
     }
 
+    /// The model's one-step error std on the set: the innovation std the bootstrap
+    /// simulates it with.
+    pub(super) fn innovation_std(&self, model: &Model) -> f64 {
+        let (s, n) = self.sse0(model, 1);
+        (s / n.max(1) as f64).sqrt()
+    }
+
     /// SSE of the base model at horizon h.
     pub(super) fn sse0(&self, model: &Model, h: usize) -> (f64, usize) {
         let mut s = 0.0;

@@ -377,8 +377,7 @@ pub fn diagnose(
         (trial, refset)
     };
     let sigma = if gear.is_some() {
-        let (s, n) = refset.sse0(base, 1);
-        (s / n.max(1) as f64).sqrt()
+        refset.innovation_std(base)
     } else {
         sigma
     };
@@ -408,8 +407,8 @@ pub fn diagnose(
         .as_ref()
         .and_then(|_| reference_hull(base, reference, cfg))
         .map(|h| {
-            let (s, n) = Set::new(&h, reference).sse0(&h, 1);
-            (h, (s / n.max(1) as f64).sqrt())
+            let s = Set::new(&h, reference).innovation_std(&h);
+            (h, s)
         });
     if let (Some(Caveat::OtherManoeuvre { hull: words, .. }), Some((h, _))) = (&mut other, &hull) {
         *words = h
