@@ -20,7 +20,8 @@ pub enum Caveat {
         /// The sentence naming the gear and its held-out fits.
         words: String,
     },
-    /// Long sets were diagnosed on blocks spread evenly over them.
+    /// Long sets were diagnosed on blocks spread evenly over them (the heading, speed and
+    /// anemometer channels on the records whole).
     Blocks {
         /// Blocks of the trials (0: used whole).
         trials: usize,
@@ -133,7 +134,8 @@ impl Caveat {
             } => format!(
                 "Records of more than {WINDOW} samples per set are diagnosed on blocks of up to \
                  {WINDOW_BLOCK} samples spread evenly over them ({trials} of the trials, \
-                 {reference} of the reference, {held_out} of the held-out records; 0: used whole)."
+                 {reference} of the reference, {held_out} of the held-out records; 0: used whole); \
+                 the heading, speed-over-ground and anemometer channels read the records whole."
             ),
             Caveat::NoReference => "No reference records were given, so every statistic is \
                 judged against the model alone: hull nonlinearity the model never had shows up \
