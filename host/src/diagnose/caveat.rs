@@ -123,6 +123,9 @@ impl Caveat {
     /// ```
     /// use yawcast::diagnose::Caveat;
     /// assert!(Caveat::NoReference.explain().starts_with("No reference records were given"));
+    /// // a model-scale ship's resolution in mm/s, not rounded to 0.00
+    /// let c = Caveat::CurrentResolution { smallest_mps: 0.00226 };
+    /// assert!(c.explain().contains("only from about 0.00226 m/s on"), "{}", c.explain());
     /// ```
     pub fn explain(&self) -> String {
         match self {
@@ -159,9 +162,10 @@ impl Caveat {
                 apart from a bias."
                 .into(),
             Caveat::CurrentResolution { smallest_mps } => format!(
-                "Speed over ground on these records shows a current only from about \
-                 {smallest_mps:.2} m/s on (in any direction, at the level applied: the headings \
-                 sailed and the speed lost in turns limit it); a weaker current cannot be told."
+                "Speed over ground on these records shows a current only from about {} m/s \
+                 on (in any direction, at the level applied: the headings sailed and the speed \
+                 lost in turns limit it); a weaker current cannot be told.",
+                super::augment::sig(*smallest_mps)
             ),
             Caveat::CurrentOrLeeway { p_moment } => format!(
                 "The current is seen on the ground track alone and no anemometer is logged: \

@@ -74,7 +74,7 @@ impl EstimateCheck {
 }
 
 /// A number with three significant digits, without trailing zeros.
-fn sig(v: f64) -> String {
+pub(crate) fn sig(v: f64) -> String {
     if v == 0.0 || !v.is_finite() {
         return format!("{v}");
     }

@@ -85,6 +85,7 @@ pub(crate) mod tests;
 mod words;
 
 pub use again::{reestimate, refit, Reestimated, Refitted};
+pub(crate) use agree::sig;
 pub use agree::{check_estimate, EstimateCheck};
 pub(crate) use auto::own_search;
 pub use auto::{own_base, OwnBase};
