@@ -5,6 +5,7 @@
 #   bench/worlds/run.sh [--yawcast PATH] [--work DIR] [--worlds LIST] [--seeds N]
 #                       [--strengths LIST] [--effects LIST] [--jobs J] [--log-wind]
 #                       [--augment] [--won-back] [--trial-input KIND] [--ref-input KIND]
+#                       [--ts S]
 #
 #   --yawcast PATH    the binary (default: build the ci profile and use it)
 #   --work DIR        records, models and diagnoses (default target/bench-worlds)
@@ -36,6 +37,9 @@
 #                     times; e.g. zigzag:20/20, the manoeuvre of most model tests)
 #   --ref-input KIND  the reference's command (default prbs); a zig-zag reference starts
 #                     from other headings than the trials' (other seeds)
+#   --ts S            the sample time of every record (`simulate --ts`; default the world's
+#                     own: 1 s, a scaled world's √(L/320) s) — the same 1 800 s sailed, logged
+#                     faster or slower
 #
 # Per world: the reference is 3 records of the world's identification input (seeds 900–902,
 # gyro noise 0.02 °/s, heading noise 0.1°) and the model identified on them; each case is 3
@@ -63,6 +67,7 @@ augment=0
 wonback=0
 trialinput=prbs
 refinput=prbs
+ts=""
 while [ $# -gt 0 ]; do
     case "$1" in
         --yawcast) yawcast="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
@@ -77,7 +82,8 @@ while [ $# -gt 0 ]; do
         --won-back) wonback=1; shift ;;
         --trial-input) trialinput="$2"; shift 2 ;;
         --ref-input) refinput="$2"; shift 2 ;;
-        -h|--help) sed -n '2,46p' "$0"; exit 0 ;;
+        --ts) ts="--ts $2"; shift 2 ;;
+        -h|--help) sed -n '2,50p' "$0"; exit 0 ;;
         *) echo "unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
@@ -87,7 +93,7 @@ if [ -z "$yawcast" ]; then
 fi
 mkdir -p "$work"
 export YAWCAST="$yawcast" WORK="$work" LOGWIND="$logwind" AUGMENT="$augment" WONBACK="$wonback"
-export TRIALINPUT="$trialinput"
+export TRIALINPUT="$trialinput" TSARG="$ts"
 
 # a world's `simulate` arguments, one a line: NAME, or NAME@L for the world scaled to L m
 world_args() {
@@ -115,7 +121,7 @@ case_run() {
         for p in "${parts[@]}"; do eff+=(--effect "$p"); done
         eff+=(--strength "$strength")
     fi
-    "$YAWCAST" simulate "${sim[@]}" "${eff[@]}" --records 3 --seed $((100 * seed)) \
+    "$YAWCAST" simulate "${sim[@]}" $TSARG "${eff[@]}" --records 3 --seed $((100 * seed)) \
         --input "$TRIALINPUT" --gyro-noise 0.03 --heading-noise 0.2 --speed-noise 0.02 $LOGWIND \
         --out "$dir/trial.csv" >"$dir/simulate.log" 2>&1
     local refs=()
@@ -152,7 +158,7 @@ print("+".join(e) if e else "none")' "$dir/augment.json")
         fits="error"
         local fit10='import json,sys
 print(json.load(open(sys.argv[1]))["records"][0]["fit"]["10"])'
-        if "$YAWCAST" simulate "${sim[@]}" "${eff[@]}" --records 1 \
+        if "$YAWCAST" simulate "${sim[@]}" $TSARG "${eff[@]}" --records 1 \
             --seed $((100 * seed + 50)) --input "$TRIALINPUT" --gyro-noise 0.03 \
             --heading-noise 0.2 --speed-noise 0.02 $LOGWIND --oracle-horizon 10 \
             --out "$dir/val.csv" --json "$dir/val.json" >"$dir/won-back.log" 2>&1 \
@@ -198,9 +204,9 @@ for w in "${world_list[@]}"; do
     mapfile -t sim < <(world_args "$w")
     # a reference is reused only when it was sailed with the same options (a work directory
     # of another run, without the anemometer say, would otherwise serve a stale one)
-    # shellcheck disable=SC2206 # $logwind: one word or none
+    # shellcheck disable=SC2206 # $logwind, $ts: one or two words, or none
     refopts=(--records 3 --seed 900 --input "$refinput" --gyro-noise 0.02 --heading-noise 0.1
-        $logwind)
+        $logwind $ts)
     stamp="${sim[*]} ${refopts[*]}"
     if [ ! -f "$work/$w/ref.postcard" ] \
         || [ "$(cat "$work/$w/ref.args" 2>/dev/null)" != "$stamp" ]; then
@@ -226,12 +232,13 @@ done
 xargs -P "$jobs" -L 1 bash -c 'case_run "$@"' _ <"$list" | sort >"$work/cases.tsv"
 secs=$(( $(date +%s) - start ))
 
-python3 - "$work/cases.tsv" "$secs" "$(nproc)" "$trialinput" "$refinput" <<'EOF'
+python3 - "$work/cases.tsv" "$secs" "$(nproc)" "$trialinput" "$refinput" "${ts#--ts }" <<'EOF'
 import collections, sys
 allrows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
 rows = [r for r in allrows if "+" not in r[2]]
 pairs = [r for r in allrows if "+" in r[2]]
 secs, cores, trialinput, refinput = sys.argv[2], sys.argv[3], sys.argv[4], sys.argv[5]
+ts = sys.argv[6]
 def accounted(augmented):
     """The effects the model augment writes accounts for: a current in the yaw-rate model
     or in its heading/track part."""
@@ -242,6 +249,8 @@ worlds = sorted({r[0] for r in allrows},
 print(f"# Cross-world diagnosis ({len(allrows)} cases, {secs} s on {cores} cores)\n")
 if (trialinput, refinput) != ("prbs", "prbs"):
     print(f"Trials sailed with `{trialinput}`, the reference with `{refinput}`.\n")
+if ts:
+    print(f"Every record logged at Ts = {ts} s.\n")
 if pairs:
     print("## Two effects: both named by the ranked verdict (verdict, then)\n")
     aug = any(r[6] != "-" for r in pairs)
