@@ -439,7 +439,7 @@ pub fn diagnose(
         cfg.seed,
         cfg.parallel,
     );
-    let nulls = null::with_spread(boot, base, reference, &grids, &real, cfg.parallel);
+    let nulls = null::with_spread(boot, base, reference, &grids, &real, est, cfg.parallel);
     bar.set_message("encompassing test, materiality");
     let evidence: Vec<Evidence> = kinds
         .iter()

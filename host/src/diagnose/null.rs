@@ -171,6 +171,57 @@ pub(super) fn reference_parts(reference: &[Record], min_len: usize) -> Vec<Vec<R
     parts
 }
 
+/// Parts of the reference the size of the trial set, when the trials' records are at most
+/// half as long as the reference's: each reference record cut into pieces of the trials'
+/// mean record length (at least `min_len`), dealt record by record in turn, and grouped as
+/// many to a part as there are trial records — at least three parts and at most
+/// [`MAX_PARTS`], else `None` ([`reference_parts`] then serves).
+///
+/// Why: `D` of a structure with no free gain fluctuates far more between short sets than
+/// between long ones, and the reference's own records measured against each other show
+/// only the long sets' spread. The built-in ship's effect-free trials cut to their first
+/// 400 s read as a 24 °/s slew limit at D = 25 (its gear slews at 20 °/s; at 900 and
+/// 1 800 s, D = 0), where the records' spread and the bootstrap both gave 0.
+pub(super) fn trial_sized_parts(
+    reference: &[Record],
+    trial: &[Record],
+    min_len: usize,
+) -> Option<Vec<Vec<Record>>> {
+    if trial.is_empty() || reference.is_empty() {
+        return None;
+    }
+    let mean = |s: &[Record]| s.iter().map(Record::len).sum::<usize>() / s.len();
+    let len = mean(trial).max(min_len);
+    if 2 * len > mean(reference) {
+        return None;
+    }
+    let mut per: Vec<std::collections::VecDeque<Record>> = reference
+        .iter()
+        .map(|r| {
+            (0..r.len() / len)
+                .map(|i| {
+                    let mut p = r.slice(i * len, (i + 1) * len);
+                    p.name = format!("{}@{}", r.name, i * len);
+                    p
+                })
+                .collect()
+        })
+        .collect();
+    let mut pieces = Vec::new();
+    while per.iter().any(|v| !v.is_empty()) {
+        pieces.extend(per.iter_mut().filter_map(|v| v.pop_front()));
+    }
+    let k = trial.len();
+    let groups = (pieces.len() / k).min(MAX_PARTS);
+    (groups >= 3).then(|| {
+        pieces
+            .chunks(k)
+            .take(groups)
+            .map(<[Record]>::to_vec)
+            .collect()
+    })
+}
+
 /// The replicates one effect's statistic is judged against: the bootstrap's, and for an
 /// effect with no free gain the reference's own spread ([`with_spread`]).
 #[derive(Debug, Clone)]
@@ -212,7 +263,8 @@ impl Nulls {
 /// on the built-in ship, one reference record against the other two shows an angle limit
 /// just under the largest command (a few per cent less gain) at D ≈ 29 scaled to the
 /// trials, and effect-free trials show the same. So each part of the reference (a record or
-/// a group of them, or a piece of one when there are fewer than three: [`reference_parts`])
+/// a group of them, or a piece of one when there are fewer than three: [`reference_parts`];
+/// pieces the size of the trials' records when those are short: [`trial_sized_parts`])
 /// is measured as a trial against the version the other parts show, `D` scaled to the
 /// trials' error count (`real[i].n`), and p is the larger of the two nulls'. Where the
 /// reference is empty or too short to cut into three parts of `MIN_SAMPLES`, the bootstrap's
@@ -223,12 +275,14 @@ pub(super) fn with_spread(
     reference: &[Record],
     grids: &[(EffectKind, Vec<Effect>)],
     real: &[super::evidence::WorldStat],
+    trial: &[Record],
     parallel: bool,
 ) -> Vec<Nulls> {
     let gainless: Vec<usize> = (0..grids.len())
         .filter(|&i| crate::effects::def(grids[i].0).gains.is_empty())
         .collect();
-    let parts = reference_parts(reference, super::MIN_SAMPLES);
+    let parts = trial_sized_parts(reference, trial, super::MIN_SAMPLES)
+        .unwrap_or_else(|| reference_parts(reference, super::MIN_SAMPLES));
     let mut spread: Vec<Option<Vec<f64>>> = vec![None; grids.len()];
     if parts.len() >= 3 && !gainless.is_empty() {
         let sub: Vec<(EffectKind, Vec<Effect>)> =
@@ -288,6 +342,40 @@ mod tests {
         // pieces too short: none
         assert!(reference_parts(&[rec(250)], 100).is_empty());
         assert!(reference_parts(&[], 100).is_empty());
+    }
+
+    #[test]
+    fn short_trials_are_matched_by_reference_pieces_of_their_size() {
+        let rec = |name: &str, n: usize| {
+            let mut r = Record::from_uy(name, 1.0, vec![0.0; n], vec![0.0; n]);
+            r.name = name.into();
+            r
+        };
+        let reference = [rec("a", 1800), rec("b", 1800), rec("c", 1800)];
+        // three trials of 400 s: 4 pieces of 400 from each reference record, dealt in
+        // turn, three to a part — four parts, each a piece of every record
+        let short = [rec("t1", 400), rec("t2", 400), rec("t3", 400)];
+        let parts = trial_sized_parts(&reference, &short, 200).unwrap();
+        assert_eq!(parts.len(), 4);
+        assert!(parts
+            .iter()
+            .all(|p| p.len() == 3 && p.iter().all(|r| r.len() == 400)));
+        let names: Vec<&str> = parts[1].iter().map(|r| r.name.as_str()).collect();
+        assert_eq!(names, ["a@400", "b@400", "c@400"]);
+        // many short trials: the parts stop at MAX_PARTS
+        let tiny = [rec("t", 250)];
+        assert_eq!(
+            trial_sized_parts(&reference, &tiny, 200).unwrap().len(),
+            MAX_PARTS
+        );
+        // trials as long as the reference's records, or more than half as long: the
+        // records' own parts serve
+        assert!(trial_sized_parts(&reference, &reference, 200).is_none());
+        assert!(trial_sized_parts(&reference, &[rec("t", 1000)], 200).is_none());
+        // a short reference that cannot give three parts
+        let one = [rec("r", 1000)];
+        assert!(trial_sized_parts(&one, &short, 200).is_none());
+        assert!(trial_sized_parts(&[], &short, 200).is_none());
     }
 
     #[test]
