@@ -11,9 +11,10 @@ use super::diagnose;
 /// on the blocks, so the time and memory a diagnosis takes stop growing with the records'
 /// length. Each block is a record of its own (its own x̂(0)); the likelihood statistics and
 /// their bootstrap nulls are measured on the same blocks, so the test keeps its level. The
-/// heading, speed-over-ground and anemometer channels are the exception: one pass each over
-/// the records whole, as their calibration compares each record with the others of its set,
-/// which pieces of one record cannot stand in for.
+/// heading, speed-over-ground and anemometer channels are the exception: they read the
+/// records whole (thinned past [`CHANNEL_WINDOW`]: [`channel_records`]), as their calibration
+/// compares each record with the others of its set, which pieces of one record cannot stand
+/// in for.
 pub const WINDOW: usize = 12_000;
 /// Length of the blocks of a set longer than [`WINDOW`] (samples).
 pub const WINDOW_BLOCK: usize = 2_000;
