@@ -36,6 +36,22 @@ fn world_records_with(
     w.simulate_many(&sc, seeds).unwrap()
 }
 
+/// The records of `sc` on world `w`, the anemometer logged, with gyro, heading and speed
+/// noise `noise` (°/s, °, m/s): the reference as the suite sails it with less noise than the
+/// trials.
+fn sailed(w: &crate::sim::World, sc: Scenario, noise: [f64; 3], seeds: &[u64]) -> Vec<Record> {
+    let sc = Scenario {
+        noise: NoiseSpec {
+            gyro_std_degps: noise[0],
+            heading_std_deg: noise[1],
+            speed_std_mps: noise[2],
+        },
+        log_wind: true,
+        ..sc
+    };
+    w.simulate_many(&sc, seeds).unwrap()
+}
+
 #[test]
 fn the_anemometer_shows_wind_and_not_a_current() {
     // Mariner at half the canonical wind: its yaw moment is too weak for the yaw channel
@@ -180,15 +196,9 @@ fn zig_zag_trials_against_a_prbs_reference_are_judged_with_the_hulls_own_physics
         let sc = Scenario {
             n_samples: 1800,
             input,
-            noise: NoiseSpec {
-                gyro_std_degps: noise[0],
-                heading_std_deg: noise[1],
-                speed_std_mps: noise[2],
-            },
-            log_wind: true,
             ..Scenario::default()
         };
-        w.simulate_many(&sc, seeds).unwrap()
+        sailed(&w, sc, noise, seeds)
     };
     let reference = sail(w.default_input(), [0.02, 0.1, 0.0], &[900, 901, 902]);
     let model = identify(&reference);
@@ -238,16 +248,10 @@ fn a_current_on_long_records_is_read_from_the_records_whole() {
             ts: 0.25,
             n_samples: 7200,
             input: w.default_input(),
-            noise: NoiseSpec {
-                gyro_std_degps: noise[0],
-                heading_std_deg: noise[1],
-                speed_std_mps: noise[2],
-            },
             effects,
-            log_wind: true,
             ..Scenario::default()
         };
-        w.simulate_many(&sc, seeds).unwrap()
+        sailed(&w, sc, noise, seeds)
     };
     let reference = sail(Vec::new(), [0.02, 0.1, 0.0], &[900, 901, 902]);
     let model = identify(&reference);
