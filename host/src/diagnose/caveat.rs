@@ -6,7 +6,8 @@ use yawcast_shared::model::EffectKind;
 use super::channels::Channels;
 use super::rule::{GAIN_PP, NO_GAIN_PP};
 use super::verdict::{effect_phrase, fmt_p, Evidence};
-use super::{WINDOW, WINDOW_BLOCK};
+use super::{MIN_SAMPLES, SLOW_HORIZON, WINDOW, WINDOW_BLOCK};
+use crate::diagnose::augment::sig;
 use crate::io::data::Record;
 
 /// What the verdict rests on that weakens or qualifies it; [`Caveat::explain`] says it in
@@ -29,6 +30,16 @@ pub enum Caveat {
         reference: usize,
         /// Of the held-out records.
         held_out: usize,
+    },
+    /// Records logged faster than once a second, long enough to be resampled to 1 s: the
+    /// slow effects are judged at [`SLOW_HORIZON`] samples, which at this sample time is a
+    /// shorter look-ahead than the ship's slow response (and, on blocks, a part of the
+    /// records' span).
+    FastLog {
+        /// The records' sample time (s).
+        ts_s: f64,
+        /// The slow effects' horizon at that sample time (s).
+        horizon_s: f64,
     },
     /// No reference records: every statistic is judged against the model alone.
     NoReference,
@@ -123,6 +134,9 @@ impl Caveat {
     /// ```
     /// use yawcast::diagnose::Caveat;
     /// assert!(Caveat::NoReference.explain().starts_with("No reference records were given"));
+    /// // a 4-Hz log: the slow horizon is 12.5 s
+    /// let c = Caveat::FastLog { ts_s: 0.25, horizon_s: 12.5 };
+    /// assert!(c.explain().contains("50-sample predictions, 12.5 s ahead"), "{}", c.explain());
     /// // a model-scale ship's resolution in mm/s, not rounded to 0.00
     /// let c = Caveat::CurrentResolution { smallest_mps: 0.00226 };
     /// assert!(c.explain().contains("only from about 0.00226 m/s on"), "{}", c.explain());
@@ -139,6 +153,16 @@ impl Caveat {
                  {WINDOW_BLOCK} samples spread evenly over them ({trials} of the trials, \
                  {reference} of the reference, {held_out} of the held-out records; 0: used whole); \
                  the heading, speed-over-ground and anemometer channels read the records whole."
+            ),
+            Caveat::FastLog { ts_s, horizon_s } => format!(
+                "Sampled every {} s, so the slow effects (a steady moment, a gyro offset, wind, \
+                 a current) are judged on {SLOW_HORIZON}-sample predictions, {} s ahead, and a \
+                 weak one shows less than at 1 s a sample. Resampled to 1 s (`--resample 1` \
+                 on identify and on diagnose), the records are judged {SLOW_HORIZON} s ahead, \
+                 as yawcast's statistics were calibrated, and on blocks only past {WINDOW} \
+                 samples a set.",
+                sig(*ts_s),
+                sig(*horizon_s)
             ),
             Caveat::NoReference => "No reference records were given, so every statistic is \
                 judged against the model alone: hull nonlinearity the model never had shows up \
@@ -271,6 +295,7 @@ impl Caveat {
 /// The caveats of a diagnosis, in the order the explanation gives them.
 pub(super) fn caveats(
     gear_words: Option<&str>,
+    fast: Option<Caveat>,
     windows: &[Option<Vec<Record>>; 3],
     has_ref: bool,
     foreign_pct: Option<f64>,
@@ -288,6 +313,7 @@ pub(super) fn caveats(
             held_out: count(&windows[2]),
         });
     }
+    out.extend(fast);
     if !has_ref {
         out.push(Caveat::NoReference);
     }
@@ -303,6 +329,19 @@ pub(super) fn caveats(
     out
 }
 
+/// [`Caveat::FastLog`] for the trials and reference records given: when their sample time is
+/// under 1 s and every record would still hold [`MIN_SAMPLES`] samples resampled to 1 s (a
+/// tank's short records would not, and are left as they are).
+pub(super) fn fast_log(records: [&[Record]; 2]) -> Option<Caveat> {
+    let recs = || records.iter().flat_map(|r| r.iter());
+    let ts_s = recs().next()?.ts;
+    let long = recs().all(|r| r.len() as f64 * r.ts >= MIN_SAMPLES as f64);
+    (ts_s < 1.0 - 1e-9 && long).then(|| Caveat::FastLog {
+        ts_s,
+        horizon_s: SLOW_HORIZON as f64 * ts_s,
+    })
+}
+
 /// The caveat for a current named from the ground track alone ([`Caveat::CurrentOrLeeway`]):
 /// of the effects `named` (the verdict's evidence, then its second effect's), a current that
 /// the yaw channel's heading-dependent moment, not an anemometer, set apart from wind
@@ -315,4 +354,41 @@ pub(super) fn current_or_leeway<'a>(
         .filter(|e| e.kind == EffectKind::Current && e.speed_only)
         .find_map(|e| e.p_moment)
         .map(|p_moment| Caveat::CurrentOrLeeway { p_moment })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn recs(ts: f64, n: usize, k: usize) -> Vec<Record> {
+        (0..k)
+            .map(|i| Record::from_uy(&format!("r{i}"), ts, vec![0.0; n], vec![0.0; n]))
+            .collect()
+    }
+
+    #[test]
+    fn fast_logs_long_enough_to_resample_are_told_to() {
+        // 30 min at 10 Hz: the slow horizon is 5 s
+        let trials = recs(0.1, 18_000, 3);
+        let reference = recs(0.1, 18_000, 3);
+        let c = fast_log([&trials, &reference]).expect("a fast log");
+        let Caveat::FastLog { ts_s, horizon_s } = c else {
+            panic!("{c:?}")
+        };
+        assert_eq!(ts_s.to_bits(), 0.1f64.to_bits());
+        assert!((horizon_s - 5.0).abs() < 1e-12, "{horizon_s}");
+        let words = c.explain();
+        assert!(words.starts_with("Sampled every 0.1 s"), "{words}");
+        assert!(words.contains("5 s ahead"), "{words}");
+        assert!(words.contains("`--resample 1`"), "{words}");
+        // at 1 s a sample, or a tank's 0.4-s records of 320 samples (128 s: resampled to 1 s
+        // they would be too short to diagnose), nothing is said
+        assert_eq!(fast_log([&recs(1.0, 1_800, 3), &recs(1.0, 1_800, 3)]), None);
+        assert_eq!(fast_log([&recs(0.4, 320, 3), &[]]), None);
+        // one record too short to resample is enough to say nothing
+        let mut mixed = recs(0.25, 7_200, 2);
+        mixed.extend(recs(0.25, 700, 1));
+        assert_eq!(fast_log([&mixed, &[]]), None);
+        assert!(fast_log([&mixed[..2], &[]]).is_some());
+    }
 }

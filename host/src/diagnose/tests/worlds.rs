@@ -266,6 +266,15 @@ fn a_current_on_long_records_is_read_from_the_records_whole() {
         "{:?}",
         d.caveats
     );
+    // 4 Hz: the slow effects look 12.5 s ahead, and the caveat says to resample
+    assert!(
+        d.caveats.contains(&Caveat::FastLog {
+            ts_s: 0.25,
+            horizon_s: 12.5
+        }),
+        "{:?}",
+        d.caveats
+    );
     assert_eq!(d.verdict, "current", "{}", d.explanation);
     // the current the ground track shows, against the one hidden
     let SimEffect::Current { speed_mps, .. } = current else {
