@@ -336,7 +336,7 @@ pub(super) fn fast_log(records: [&[Record]; 2]) -> Option<Caveat> {
     let recs = || records.iter().flat_map(|r| r.iter());
     let ts_s = recs().next()?.ts;
     let long = recs().all(|r| r.len() as f64 * r.ts >= MIN_SAMPLES as f64);
-    (ts_s < 1.0 - 1e-9 && long).then(|| Caveat::FastLog {
+    (ts_s < 1.0 - 1e-9 && long).then_some(Caveat::FastLog {
         ts_s,
         horizon_s: SLOW_HORIZON as f64 * ts_s,
     })
