@@ -151,7 +151,10 @@ pub fn validate_record(
 /// never leave ±1.6 (radians under a degree header: π/2 rad is 90°) and yaw rates that never
 /// leave ±0.05 °/s while the commands reach 2° (rad/s under a °/s header: a ship turning
 /// visibly does more than 3°/min), and a sample time above a minute (milliseconds under a
-/// seconds header: no yaw predictor samples that slowly). Empty when nothing looks wrong.
+/// seconds header: no yaw predictor samples that slowly). Where the heading is logged and
+/// the record turns, the heading says it outright: it turns about 57.3 times what a yaw rate
+/// in rad/s integrates to, and −1 times what one of the other sign does (a gyro positive to
+/// port). Empty when nothing looks wrong.
 ///
 /// ```
 /// use yawcast::io::data::{unit_warnings, Record};
@@ -188,8 +191,76 @@ pub fn unit_warnings(rec: &Record) -> Vec<String> {
             "the yaw rate never leaves ±{dy:.4} °/s while the commands reach {du:.0}°: if it \
              is in rad/s, give --rate-unit radps"
         ));
+        return out;
+    }
+    // the heading, where logged, says outright how the yaw rate is scaled and signed
+    if let Some(b) = heading_turn_ratio(rec) {
+        let rad = 180.0 / std::f64::consts::PI;
+        if (0.6 * rad..=1.6 * rad).contains(&b) {
+            out.push(format!(
+                "the heading turns {b:.1} times what the yaw rate integrates to (57.3 is \
+                 rad/s under a °/s header): if the yaw rate is in rad/s, give --rate-unit radps"
+            ));
+        } else if (-1.6 * rad..=-0.6 * rad).contains(&b) {
+            out.push(format!(
+                "the heading turns {b:.1} times what the yaw rate integrates to: the yaw rate \
+                 looks like rad/s of the opposite sign (give --rate-unit radps and negate it)"
+            ));
+        } else if (-1.5..=-0.67).contains(&b) {
+            out.push(format!(
+                "the heading turns {b:.2} times what the yaw rate integrates to: the yaw rate \
+                 is positive the other way round (yawcast's is positive when the heading \
+                 grows, to starboard); negate the yaw-rate column"
+            ));
+        }
     }
     out
+}
+
+/// How many degrees the heading turns per degree the yaw rate integrates to, `b` in
+/// `ψ(t) − ψ(0) = b·∫r dt + c·t` (least squares; `c` takes a gyro offset): 1 when both are
+/// in degrees and signed alike. `None` without a heading, or where the record does not turn
+/// enough to tell (the heading moves less than 10° rms about its straight line in time) or
+/// the fit explains less than 90 % of the heading's variation.
+fn heading_turn_ratio(rec: &Record) -> Option<f64> {
+    let psi = rec.psi.as_ref()?;
+    let n = rec.len();
+    if n < 10 || psi.len() != n {
+        return None;
+    }
+    let mut h = psi.clone();
+    unwrap_degrees(&mut h);
+    // the integrated rate (trapezoid) and time, both from 0
+    let mut int = vec![0.0; n];
+    for t in 1..n {
+        int[t] = int[t - 1] + 0.5 * (rec.y[t - 1] + rec.y[t]) * rec.ts;
+    }
+    let time: Vec<f64> = (0..n).map(|t| t as f64 * rec.ts).collect();
+    let dh: Vec<f64> = h.iter().map(|v| v - h[0]).collect();
+    if dh.iter().chain(&int).any(|v| !v.is_finite()) {
+        return None;
+    }
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+    let (rr, rt, tt) = (dot(&int, &int), dot(&int, &time), dot(&time, &time));
+    let (rh, th) = (dot(&int, &dh), dot(&time, &dh));
+    let det = rr * tt - rt * rt;
+    if det <= 0.0 || tt <= 0.0 {
+        return None;
+    }
+    // how far the heading moves about its own straight line through 0 in time (rms)
+    let hh = dot(&dh, &dh);
+    let wiggle = ((hh - th * th / tt) / n as f64).max(0.0).sqrt();
+    if wiggle < 10.0 {
+        return None;
+    }
+    let b = (rh * tt - th * rt) / det;
+    let c = (rr * th - rt * rh) / det;
+    let sse: f64 = (0..n)
+        .map(|t| (dh[t] - b * int[t] - c * time[t]).powi(2))
+        .sum();
+    let mean = dh.iter().sum::<f64>() / n as f64;
+    let sst: f64 = dh.iter().map(|v| (v - mean).powi(2)).sum();
+    (sst > 0.0 && sse <= 0.1 * sst).then_some(b)
 }
 
 /// Removes the 360° jumps of a heading logged in [0, 360) (or (−180, 180]): each sample

@@ -422,3 +422,63 @@ fn resampling_absorbs_gaps_and_another_rate() {
     let e = parse_csv(back, "b.csv".as_ref(), "b", &cols).unwrap_err();
     assert!(matches!(e, DataError::NonUniform { row: 3, .. }), "{e}");
 }
+
+#[test]
+fn the_heading_tells_a_yaw_rate_in_rad_per_s_or_of_the_other_sign() {
+    // a ship weaving ±amp° about a course that creeps round, heading logged in [0, 360) with
+    // compass noise; the gyro reads 0.05 °/s high
+    let weave = |amp: f64| {
+        let n = 1_800;
+        let mut rec = Record::from_uy(
+            "weave",
+            1.0,
+            (0..n)
+                .map(|t| if (t / 60) % 2 == 0 { 15.0 } else { -15.0 })
+                .collect(),
+            (0..n)
+                .map(|t| amp * 0.02 * (0.02 * t as f64).cos() + 0.01 + 0.05)
+                .collect(),
+        );
+        rec.psi = Some(
+            (0..n)
+                .map(|t| {
+                    let t = t as f64;
+                    let noise = 0.2 * ((t * 12.9898).sin() * 43_758.547).fract();
+                    (200.0 + amp * (0.02 * t).sin() + 0.01 * t + noise).rem_euclid(360.0)
+                })
+                .collect(),
+        );
+        rec
+    };
+    let scaled = |mut r: Record, k: f64| {
+        r.y.iter_mut().for_each(|y| *y *= k);
+        unit_warnings(&r)
+    };
+    let rad = std::f64::consts::PI / 180.0;
+    // rates of up to 4.8 °/s: in rad/s (0.08) beyond the span test's ±0.05
+    let fast = weave(240.0);
+    assert!(
+        unit_warnings(&fast).is_empty(),
+        "{:?}",
+        unit_warnings(&fast)
+    );
+    let w = scaled(fast.clone(), rad);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].contains("57.") && w[0].contains("--rate-unit radps"),
+        "{w:?}"
+    );
+    let w = scaled(fast.clone(), -rad);
+    assert!(w.len() == 1 && w[0].contains("opposite sign"), "{w:?}");
+    let w = scaled(fast, -1.0);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].contains("-1.00 times") && w[0].contains("negate"),
+        "{w:?}"
+    );
+    // weaving ±60° (rates of up to 1.2 °/s): the sign is told as well
+    let w = scaled(weave(60.0), -1.0);
+    assert!(w.len() == 1 && w[0].contains("negate"), "{w:?}");
+    // weaving ±5°: too little turning to tell, nothing said either way
+    assert!(scaled(weave(5.0), -1.0).is_empty());
+}
