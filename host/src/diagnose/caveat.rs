@@ -6,7 +6,7 @@ use yawcast_shared::model::EffectKind;
 use super::channels::Channels;
 use super::rule::{GAIN_PP, NO_GAIN_PP};
 use super::verdict::{effect_phrase, fmt_p, Evidence};
-use super::{MIN_SAMPLES, SLOW_HORIZON, WINDOW, WINDOW_BLOCK};
+use super::{MIN_SAMPLES, WINDOW, WINDOW_BLOCK};
 use crate::diagnose::augment::sig;
 use crate::io::data::Record;
 
@@ -30,16 +30,12 @@ pub enum Caveat {
         reference: usize,
         /// Of the held-out records.
         held_out: usize,
-    },
-    /// Records logged faster than once a second, long enough to be resampled to 1 s: the
-    /// slow effects are judged at [`SLOW_HORIZON`] samples, which at this sample time is a
-    /// shorter look-ahead than the ship's slow response (and, on blocks, a part of the
-    /// records' span).
-    FastLog {
-        /// The records' sample time (s).
-        ts_s: f64,
-        /// The slow effects' horizon at that sample time (s).
-        horizon_s: f64,
+        /// The sample time (s), a whole multiple of the records', at which every set would
+        /// fit in [`WINDOW`] samples and so be read whole, with each record still
+        /// [`MIN_SAMPLES`] long (`None` when none is): the slow effects (a steady moment, a
+        /// gyro offset, wind, a current) show with the span of the records read, not with
+        /// the number of samples.
+        resample_s: Option<f64>,
     },
     /// No reference records: every statistic is judged against the model alone.
     NoReference,
@@ -134,9 +130,9 @@ impl Caveat {
     /// ```
     /// use yawcast::diagnose::Caveat;
     /// assert!(Caveat::NoReference.explain().starts_with("No reference records were given"));
-    /// // a 4-Hz log: the slow horizon is 12.5 s
-    /// let c = Caveat::FastLog { ts_s: 0.25, horizon_s: 12.5 };
-    /// assert!(c.explain().contains("50-sample predictions, 12.5 s ahead"), "{}", c.explain());
+    /// // three 30-min records at 10 Hz a set: at 0.5 s they would be read whole
+    /// let c = Caveat::Blocks { trials: 6, reference: 6, held_out: 0, resample_s: Some(0.5) };
+    /// assert!(c.explain().contains("`--resample 0.5` on identify and on diagnose"));
     /// // a model-scale ship's resolution in mm/s, not rounded to 0.00
     /// let c = Caveat::CurrentResolution { smallest_mps: 0.00226 };
     /// assert!(c.explain().contains("only from about 0.00226 m/s on"), "{}", c.explain());
@@ -148,22 +144,27 @@ impl Caveat {
                 trials,
                 reference,
                 held_out,
-            } => format!(
-                "Records of more than {WINDOW} samples per set are diagnosed on blocks of up to \
-                 {WINDOW_BLOCK} samples spread evenly over them ({trials} of the trials, \
-                 {reference} of the reference, {held_out} of the held-out records; 0: used whole); \
-                 the heading, speed-over-ground and anemometer channels read the records whole."
-            ),
-            Caveat::FastLog { ts_s, horizon_s } => format!(
-                "Sampled every {} s, so the slow effects (a steady moment, a gyro offset, wind, \
-                 a current) are judged on {SLOW_HORIZON}-sample predictions, {} s ahead, and a \
-                 weak one shows less than at 1 s a sample. Resampled to 1 s (`--resample 1` \
-                 on identify and on diagnose), the records are judged {SLOW_HORIZON} s ahead, \
-                 as yawcast's statistics were calibrated, and on blocks only past {WINDOW} \
-                 samples a set.",
-                sig(*ts_s),
-                sig(*horizon_s)
-            ),
+                resample_s,
+            } => {
+                let mut w = format!(
+                    "Records of more than {WINDOW} samples per set are diagnosed on blocks of \
+                     up to {WINDOW_BLOCK} samples spread evenly over them ({trials} of the \
+                     trials, {reference} of the reference, {held_out} of the held-out \
+                     records; 0: used whole); the heading, speed-over-ground and anemometer \
+                     channels read the records whole."
+                );
+                if let Some(step) = resample_s {
+                    let step = sig(*step);
+                    w.push_str(&format!(
+                        " The slow effects (a steady moment, a gyro offset, wind, a current) \
+                         show with the span of the records read, so on blocks a weak one can \
+                         go unseen: resampled to {step} s (`--resample {step}` on identify and \
+                         on diagnose) every set is read whole, while a dead time or a slew \
+                         limit is best judged at the sample time logged."
+                    ));
+                }
+                w
+            }
             Caveat::NoReference => "No reference records were given, so every statistic is \
                 judged against the model alone: hull nonlinearity the model never had shows up \
                 as an effect, and the verdict is weaker."
@@ -295,7 +296,7 @@ impl Caveat {
 /// The caveats of a diagnosis, in the order the explanation gives them.
 pub(super) fn caveats(
     gear_words: Option<&str>,
-    fast: Option<Caveat>,
+    records: [&[Record]; 3],
     windows: &[Option<Vec<Record>>; 3],
     has_ref: bool,
     foreign_pct: Option<f64>,
@@ -311,9 +312,9 @@ pub(super) fn caveats(
             trials: count(&windows[0]),
             reference: count(&windows[1]),
             held_out: count(&windows[2]),
+            resample_s: resample_step(records),
         });
     }
-    out.extend(fast);
     if !has_ref {
         out.push(Caveat::NoReference);
     }
@@ -329,17 +330,22 @@ pub(super) fn caveats(
     out
 }
 
-/// [`Caveat::FastLog`] for the trials and reference records given: when their sample time is
-/// under 1 s and every record would still hold [`MIN_SAMPLES`] samples resampled to 1 s (a
-/// tank's short records would not, and are left as they are).
-pub(super) fn fast_log(records: [&[Record]; 2]) -> Option<Caveat> {
-    let recs = || records.iter().flat_map(|r| r.iter());
-    let ts_s = recs().next()?.ts;
-    let long = recs().all(|r| r.len() as f64 * r.ts >= MIN_SAMPLES as f64);
-    (ts_s < 1.0 - 1e-9 && long).then_some(Caveat::FastLog {
-        ts_s,
-        horizon_s: SLOW_HORIZON as f64 * ts_s,
-    })
+/// The sample time [`Caveat::Blocks`] suggests for `sets` (trials, reference, held-out):
+/// the smallest whole multiple `k·Ts` of the records' at which every set holds at most
+/// [`WINDOW`] samples, or `None` when a record would then hold fewer than [`MIN_SAMPLES`] (or
+/// no set needs blocks).
+fn resample_step(sets: [&[Record]; 3]) -> Option<f64> {
+    let ts = sets.iter().flat_map(|s| s.iter()).next()?.ts;
+    let most = sets
+        .iter()
+        .map(|s| s.iter().map(Record::len).sum::<usize>())
+        .max()?;
+    let k = most.div_ceil(WINDOW);
+    let long = sets
+        .iter()
+        .flat_map(|s| s.iter())
+        .all(|r| r.len() / k >= MIN_SAMPLES);
+    (k > 1 && long).then_some(k as f64 * ts)
 }
 
 /// The caveat for a current named from the ground track alone ([`Caveat::CurrentOrLeeway`]):
@@ -367,28 +373,40 @@ mod tests {
     }
 
     #[test]
-    fn fast_logs_long_enough_to_resample_are_told_to() {
-        // 30 min at 10 Hz: the slow horizon is 5 s
-        let trials = recs(0.1, 18_000, 3);
-        let reference = recs(0.1, 18_000, 3);
-        let c = fast_log([&trials, &reference]).expect("a fast log");
-        let Caveat::FastLog { ts_s, horizon_s } = c else {
-            panic!("{c:?}")
+    fn blocks_say_at_what_sample_time_the_sets_would_be_read_whole() {
+        // three 30-min records a set at 10 Hz: 54 000 samples, whole at 0.5 s (10 800)
+        let (trials, reference) = (recs(0.1, 18_000, 3), recs(0.1, 18_000, 3));
+        let step = resample_step([&trials, &reference, &[]]).expect("a step");
+        assert_eq!(step.to_bits(), 0.5f64.to_bits());
+        let c = Caveat::Blocks {
+            trials: 6,
+            reference: 6,
+            held_out: 0,
+            resample_s: Some(step),
         };
-        assert_eq!(ts_s.to_bits(), 0.1f64.to_bits());
-        assert!((horizon_s - 5.0).abs() < 1e-12, "{horizon_s}");
-        let words = c.explain();
-        assert!(words.starts_with("Sampled every 0.1 s"), "{words}");
-        assert!(words.contains("5 s ahead"), "{words}");
-        assert!(words.contains("`--resample 1`"), "{words}");
-        // at 1 s a sample, or a tank's 0.4-s records of 320 samples (128 s: resampled to 1 s
-        // they would be too short to diagnose), nothing is said
-        assert_eq!(fast_log([&recs(1.0, 1_800, 3), &recs(1.0, 1_800, 3)]), None);
-        assert_eq!(fast_log([&recs(0.4, 320, 3), &[]]), None);
-        // one record too short to resample is enough to say nothing
-        let mut mixed = recs(0.25, 7_200, 2);
-        mixed.extend(recs(0.25, 700, 1));
-        assert_eq!(fast_log([&mixed, &[]]), None);
-        assert!(fast_log([&mixed[..2], &[]]).is_some());
+        assert!(
+            c.explain().contains("resampled to 0.5 s (`--resample 0.5`"),
+            "{}",
+            c.explain()
+        );
+        // at 4 Hz, 21 600 samples a set: 0.5 s
+        let four = recs(0.25, 7_200, 3);
+        assert_eq!(resample_step([&four, &four, &[]]), Some(0.5));
+        // a set that fits is read whole: nothing to suggest
+        assert_eq!(resample_step([&recs(1.0, 1_800, 3), &[], &[]]), None);
+        // ten 1-h records at 1 Hz (36 000) would be whole at 3 s, each record 1 200 long
+        assert_eq!(resample_step([&recs(1.0, 3_600, 10), &[], &[]]), Some(3.0));
+        // one short record among long ones: resampled it would fall under MIN_SAMPLES
+        let mut mixed = recs(0.25, 7_200, 3);
+        mixed.push(recs(0.25, 300, 1).remove(0));
+        assert_eq!(resample_step([&mixed, &[], &[]]), None);
+        // without blocks the caveat has no such sentence
+        let plain = Caveat::Blocks {
+            trials: 6,
+            reference: 0,
+            held_out: 0,
+            resample_s: None,
+        };
+        assert!(!plain.explain().contains("resample"), "{}", plain.explain());
     }
 }

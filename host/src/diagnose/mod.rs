@@ -335,7 +335,7 @@ pub fn diagnose(
     // call, with the intermediate results they share held here.
     check(model, reference, est, val, cfg)?;
     let reps = cfg.null_reps.max(8);
-    let fast = caveat::fast_log([est, reference]);
+    let given = [est, reference, val];
     // long sets are diagnosed on blocks spread over them (see `WINDOW`)
     let windows = [window(est), window(reference), window(val)];
     // the heading, speed-over-ground and anemometer channels read the records whole (thinned
@@ -523,7 +523,7 @@ pub fn diagnose(
         verdict_words(&ev, &ranking, verdict, has_ref, cfg.alpha, &before);
     let mut caveats = caveats(
         gear.as_ref().map(|g| g.words.as_str()),
-        fast,
+        given,
         &windows,
         has_ref,
         foreign_pct,
