@@ -56,6 +56,17 @@ pub enum RateUnit {
     Radps,
 }
 
+/// Unit of the CSV speed columns (speed over ground, wind speed).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SpeedUnit {
+    /// Metres per second.
+    Mps,
+    /// Knots (1 852 m an hour).
+    Kn,
+    /// Kilometres an hour.
+    Kmh,
+}
+
 /// File format of a record.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum Format {
@@ -119,6 +130,9 @@ pub struct ReadArgs {
     /// Unit of the CSV yaw-rate column.
     #[arg(long, value_enum, default_value = "degps")]
     pub rate_unit: RateUnit,
+    /// Unit of the CSV speed columns (speed over ground, wind speed).
+    #[arg(long, value_enum, default_value = "mps")]
+    pub speed_unit: SpeedUnit,
     /// CSV: resample onto a uniform grid of this step (s) — command held, other channels
     /// interpolated — instead of requiring uniform time stamps.
     #[arg(long, value_name = "SECONDS")]
@@ -164,6 +178,7 @@ impl Default for ReadArgs {
             col_east: "east_m".into(),
             angle_unit: AngleUnit::Deg,
             rate_unit: RateUnit::Degps,
+            speed_unit: SpeedUnit::Mps,
             nmea_rate: None,
             nmea_ts: None,
             max_gap: None,
@@ -196,6 +211,11 @@ impl ReadArgs {
             rate_scale: match self.rate_unit {
                 RateUnit::Degps => 1.0,
                 RateUnit::Radps => rad,
+            },
+            speed_scale: match self.speed_unit {
+                SpeedUnit::Mps => 1.0,
+                SpeedUnit::Kn => 1852.0 / 3600.0,
+                SpeedUnit::Kmh => 1.0 / 3.6,
             },
             resample: self.resample,
         }

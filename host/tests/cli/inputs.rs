@@ -134,6 +134,17 @@ fn custom_columns_and_units() {
         j2.to_str().unwrap(),
     ]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
+    // the speed unit is an option of every reading command (knots, km/h, m/s)
+    let o = run(&[
+        "compare",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        d.join("deg.csv").to_str().unwrap(),
+        "--speed-unit",
+        "kn",
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
     let a: serde_json::Value = serde_json::from_slice(&std::fs::read(j1).unwrap()).unwrap();
     let b: serde_json::Value = serde_json::from_slice(&std::fs::read(j2).unwrap()).unwrap();
     for h in ["1", "5", "10", "20", "sim"] {

@@ -28,6 +28,8 @@ pub struct Columns {
     pub angle_scale: f64,
     /// Multiply the yaw-rate column by this to get deg/s.
     pub rate_scale: f64,
+    /// Multiply the speed columns (`speed`, `wind_speed`) by this to get m/s.
+    pub speed_scale: f64,
     /// Resample onto a uniform grid of this step (s) instead of requiring uniform time stamps.
     pub resample: Option<f64>,
 }
@@ -45,6 +47,7 @@ impl Default for Columns {
             cog: "cog_deg".into(),
             angle_scale: 1.0,
             rate_scale: 1.0,
+            speed_scale: 1.0,
             resample: None,
         }
     }
@@ -167,10 +170,10 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
             v.push(cell(i)? * cols.angle_scale);
         }
         if let (Some(i), Some(v)) = (isp, rec.speed.as_mut()) {
-            v.push(cell(i)?);
+            v.push(cell(i)? * cols.speed_scale);
         }
         if let (Some(i), Some(v)) = (iws, rec.wind_speed.as_mut()) {
-            v.push(cell(i)?);
+            v.push(cell(i)? * cols.speed_scale);
         }
         if let (Some(i), Some(v)) = (iwa, rec.wind_angle.as_mut()) {
             v.push(cell(i)? * cols.angle_scale);

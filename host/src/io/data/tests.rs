@@ -482,3 +482,29 @@ fn the_heading_tells_a_yaw_rate_in_rad_per_s_or_of_the_other_sign() {
     // weaving ±5°: too little turning to tell, nothing said either way
     assert!(scaled(weave(5.0), -1.0).is_empty());
 }
+
+#[test]
+fn speeds_in_knots_or_km_per_h_are_read_as_m_per_s() {
+    let txt = "t_s,delta_deg,r_degps,psi_deg,u_mps,wind_speed_mps,wind_angle_deg\n\
+               0,5,0.1,10,14,20,30\n1,-5,0.2,10.1,14.5,19,31\n";
+    let read = |speed_scale: f64| {
+        let cols = Columns {
+            speed_scale,
+            ..Columns::default()
+        };
+        parse_csv(txt, "kn.csv".as_ref(), "kn", &cols).unwrap()
+    };
+    let mps = read(1.0);
+    assert_eq!(mps.speed.as_deref(), Some(&[14.0, 14.5][..]));
+    let kn = read(1852.0 / 3600.0);
+    let sp = kn.speed.unwrap();
+    assert!(
+        (sp[0] - 7.202_222).abs() < 1e-6 && (sp[1] - 7.459_444).abs() < 1e-6,
+        "{sp:?}"
+    );
+    let ws = kn.wind_speed.unwrap();
+    assert!((ws[0] - 10.288_889).abs() < 1e-6, "{ws:?}");
+    // the other columns are untouched
+    assert_eq!((kn.u, kn.y), (mps.u, mps.y));
+    assert_eq!(kn.wind_angle, mps.wind_angle);
+}
