@@ -310,6 +310,7 @@ impl ReadArgs {
             lon: self.col_lon.clone(),
             north: self.col_north.clone(),
             east: self.col_east.clone(),
+            sog_scale: self.columns().speed_scale,
         }
     }
 

@@ -29,6 +29,8 @@ pub struct NavColumns {
     pub north: String,
     /// Position east of an origin (m).
     pub east: String,
+    /// Multiply the speed-over-ground column by this to get m/s (1 for m/s).
+    pub sog_scale: f64,
 }
 
 impl Default for NavColumns {
@@ -40,6 +42,7 @@ impl Default for NavColumns {
             lon: "lon_deg".into(),
             north: "north_m".into(),
             east: "east_m".into(),
+            sog_scale: 1.0,
         }
     }
 }
@@ -228,6 +231,11 @@ pub fn local_metres(origin: [f64; 2], p: [f64; 2]) -> [f64; 2] {
 /// let nav = parse_nav_csv(txt, "x.csv".as_ref(), &NavColumns::default(), 3, 1.0)
 ///     .unwrap().unwrap();
 /// assert_eq!(nav.missing, 1);
+/// assert!((nav.velocity(0).unwrap()[0] - 1.0).abs() < 1e-3);
+/// // the same speeds in knots
+/// let kn = NavColumns { sog_scale: 1852.0 / 3600.0, ..NavColumns::default() };
+/// let nav = parse_nav_csv(txt, "x.csv".as_ref(), &kn, 3, 1.0).unwrap().unwrap();
+/// assert!((nav.velocity(0).unwrap()[0] - 0.514).abs() < 1e-3);
 /// let bad = "t_s,delta_deg,r_degps,u_mps,cog_deg\n0,0,0,-1.0,3\n";
 /// let e = parse_nav_csv(bad, "x.csv".as_ref(), &NavColumns::default(), 1, 1.0).unwrap_err();
 /// assert_eq!(e.to_string(), "x.csv: row 1, column `u_mps`: speed over ground -1 m/s is negative");
@@ -330,7 +338,7 @@ pub fn parse_nav_csv(
             if sog < 0.0 {
                 return Err(bad(is, format!("speed over ground {sog} m/s is negative")));
             }
-            vel.push(ground_velocity(sog, cell(ic)?));
+            vel.push(ground_velocity(sog * cols.sog_scale, cell(ic)?));
         }
         if let Some((ia, io)) = latlon {
             let (lat, lon) = (cell(ia)?, cell(io)?);
