@@ -345,8 +345,12 @@ impl ReadArgs {
         if self.resample.is_some() {
             return Ok(None);
         }
-        parse_nav_csv(&text, path, &self.nav_columns(), rec.len(), rec.ts)
-            .map_err(|e| bad(e.to_string()))
+        let nav = parse_nav_csv(&text, path, &self.nav_columns(), rec.len(), rec.ts)
+            .map_err(|e| bad(e.to_string()))?;
+        if let Some(w) = nav.as_ref().and_then(|n| n.speed_unit_warning(rec.ts)) {
+            eprintln!("warning: {}: {w}", path.display());
+        }
+        Ok(nav)
     }
 
     /// Reads several record files, in order.

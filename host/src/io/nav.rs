@@ -181,6 +181,51 @@ impl Nav {
         self.velocity.is_some()
     }
 
+    /// A warning when the speed over ground and the positions disagree by the factor of a
+    /// unit mix-up: the distance the speed integrates to, against the distance the fixes
+    /// travel (over steps of 10 samples, so position noise does not add up), 1.94 for knots
+    /// and 3.6 for km/h read as m/s. `None` with one of the two channels missing, fewer than
+    /// 100 m travelled, or a ratio that is no such factor.
+    ///
+    /// ```
+    /// use yawcast::io::nav::Nav;
+    /// // 600 s at 5 m/s north, the speed column in knots (9.72) read as m/s
+    /// let v = vec![[5.0 * 3600.0 / 1852.0, 0.0]; 600];
+    /// let fix: Vec<[f64; 2]> = (0..600).map(|t| [5.0 * t as f64, 0.0]).collect();
+    /// let nav = Nav::new(1.0, Some(v), Some(fix.clone()), "test").unwrap();
+    /// assert!(nav.speed_unit_warning(1.0).unwrap().contains("--speed-unit kn"));
+    /// let nav = Nav::new(1.0, Some(vec![[5.0, 0.0]; 600]), Some(fix), "test").unwrap();
+    /// assert_eq!(nav.speed_unit_warning(1.0), None);
+    /// ```
+    pub fn speed_unit_warning(&self, ts: f64) -> Option<String> {
+        const STEP: usize = 10;
+        let (v, f) = (self.velocity.as_ref()?, self.fix.as_ref()?);
+        let ok = |p: &[f64; 2]| p[0].is_finite() && p[1].is_finite();
+        let (mut by_speed, mut by_fix) = (0.0, 0.0);
+        let mut t = 0;
+        while t + STEP < f.len().min(v.len()) {
+            let (a, b) = (f[t], f[t + STEP]);
+            let seg = &v[t..t + STEP];
+            if ok(&a) && ok(&b) && seg.iter().all(ok) {
+                by_fix += (b[0] - a[0]).hypot(b[1] - a[1]);
+                by_speed += seg.iter().map(|p| p[0].hypot(p[1]) * ts).sum::<f64>();
+            }
+            t += STEP;
+        }
+        if by_fix < 100.0 {
+            return None;
+        }
+        let ratio = by_speed / by_fix;
+        let unit = [(3600.0 / 1852.0, "kn", "knots"), (3.6, "kmh", "km/h")]
+            .into_iter()
+            .find(|(k, _, _)| (ratio / k - 1.0).abs() < 0.1)?;
+        Some(format!(
+            "the speed over ground integrates to {ratio:.2} times the distance the positions \
+             travel: if it is in {}, give --speed-unit {}",
+            unit.2, unit.1
+        ))
+    }
+
     /// Whether position fixes are logged.
     pub fn has_fix(&self) -> bool {
         self.fix.is_some()
