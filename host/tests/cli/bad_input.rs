@@ -54,6 +54,11 @@ fn bad_input_suite() {
         ("huge_cell.csv", rows(&|i, l| set(i, 40, 2, "3.4e200", l)).into_bytes()),
         ("rudder.csv", rows(&|i, l| set(i, 12, 1, "2000000", l)).into_bytes()),
         ("zero.csv", rows(&|i, _| format!("{},0,0", t(i))).into_bytes()),
+        ("flipped.csv", rows(&|i, l| {
+            let c: Vec<&str> = l.split(',').collect();
+            let d: f64 = c[1].parse().unwrap();
+            set(i, i, 1, &format!("{}", -d), l)
+        }).into_bytes()),
         ("held.csv", rows(&|i, l| set(i, i, 1, "7", l)).into_bytes()),
         ("stuck.csv", rows(&|i, l| set(i, i, 2, "0", l)).into_bytes()),
         ("tiny.csv", rows(&|i, l| set(i, i, 2, &format!("{}e-300", i % 3), l)).into_bytes()),
@@ -86,6 +91,8 @@ fn bad_input_suite() {
         ),
         ("semi_bad.csv", b"t_s;delta_deg;r_degps\n0;1,5;x\n0,5;2;0\n".to_vec()),
         ("not_json.json", b"{ this is not json".to_vec()),
+        // the model the good records were made with (`csv4`)
+        ("csv4.json", br#"{"n":4,"ts":0.5,"a":[-0.08645,0.6135,-1.785,2.25],"b":[0.02,0.035,0.045,0.05],"k":[0.0,0.0,0.0,0.0],"effects":[]}"#.to_vec()),
         ("schema.json", br#"{"n":2,"ts":0.5,"a":[1,2]}"#.to_vec()),
         ("huge.json", br#"{"n":2,"ts":0.5,"a":[1e308,0.7],"b":[0.01,0.02],"k":[0.5,0.2],"effects":[]}"#.to_vec()),
         ("unstable.json", br#"{"n":2,"ts":0.5,"a":[0.0,1.3],"b":[0.01,0.02],"k":[0.0,0.0],"effects":[]}"#.to_vec()),
@@ -116,6 +123,8 @@ fn bad_input_suite() {
         bad("2e6° rudder", "identify --data {d}/rudder.csv --out {d}/out", &["rudder.csv", "row 12", "delta_deg", "--max-angle"]),
         bad("2e6° rudder, compare", "compare --model {model} --data {d}/rudder.csv --json {d}/out-summary.json", &["rudder.csv", "row 12"]),
         bad("all-zero trial", "diagnose --model {model} --data {d}/zero.csv --reference {d}/good.csv --json {d}/out-summary.json", &["zero.csv", "constant"]),
+        bad("command of the other sign, diagnose", "diagnose --model {d}/csv4.json --data {d}/flipped.csv --reference {d}/good.csv --json {d}/out-summary.json", &["trial record `flipped`", "with the command negated", "negate its command column"]),
+        bad("command of the other sign, augment", "augment --model {d}/csv4.json --effect bias --data {d}/flipped.csv --out {d}/out --json {d}/out-summary.json", &["estimation record `flipped`", "negate its command column"]),
         bad("rudder never moves", "tune --data {d}/good.csv --validate {d}/held.csv --out {d}/out", &["held.csv", "delta_deg", "constant"]),
         bad("yaw rate stuck at zero", "identify --data {d}/stuck.csv --out {d}/out", &["stuck.csv", "r_degps", "constant"]),
         bad("1e-300 yaw rate", "compare --model {model} --data {d}/tiny.csv --json {d}/out-summary.json", &["tiny.csv", "r_degps"]),
