@@ -160,6 +160,18 @@ pub fn run(args: &DiagnoseArgs) -> Result<()> {
     Ok(())
 }
 
+/// A held-out gain (pp) for the table: two decimals, or in exponent form when a refit that
+/// diverged in simulation lost more than the column holds (`-6.1e38`, `-inf`).
+fn pp(v: f64) -> String {
+    if v.is_finite() && v.abs() < 1e5 {
+        format!("{v:.2}")
+    } else if v.is_finite() {
+        format!("{v:.1e}")
+    } else {
+        v.to_string()
+    }
+}
+
 fn print_report(d: &Diagnosis) {
     // ranked by the likelihood gain above noise; far-tail p-values are not compared
     // held-out gains: at the effect's own horizon ("gain pp"), then at 10 steps and in
@@ -179,7 +191,7 @@ fn print_report(d: &Diagnosis) {
     );
     for r in &d.ranking {
         println!(
-            "{:<18} {:>12.1} {:>12.1} {:>10} {:>9.2} {:>7.2} {:>7.2} {:>4} {:>4} {:>10}",
+            "{:<18} {:>12.1} {:>12.1} {:>10} {:>9} {:>7} {:>7} {:>4} {:>4} {:>10}",
             r.effect,
             r.statistic,
             r.above_noise,
@@ -188,9 +200,9 @@ fn print_report(d: &Diagnosis) {
             } else {
                 format!("{:.2e}", r.p_value)
             },
-            r.fit_gain_pp,
-            r.fit_gain_10_pp,
-            r.fit_gain_sim_pp,
+            pp(r.fit_gain_pp),
+            pp(r.fit_gain_10_pp),
+            pp(r.fit_gain_sim_pp),
             if r.significant { "yes" } else { "no" },
             if r.material { "yes" } else { "no" },
             r.parameter.map_or("-".to_string(), |p| format!("{p:.3}"))
@@ -314,4 +326,17 @@ fn plot_fits(d: &Diagnosis) -> Result<String> {
         root.present().map_err(plot_err)?;
     }
     Ok(svg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::pp;
+
+    #[test]
+    fn gains_beyond_the_column_are_printed_in_exponent_form() {
+        assert_eq!(pp(7.514), "7.51");
+        assert_eq!(pp(-0.004), "-0.00");
+        assert_eq!(pp(-6.078e38), "-6.1e38");
+        assert_eq!(pp(f64::NEG_INFINITY), "-inf");
+    }
 }
