@@ -744,7 +744,9 @@ pub fn average(args: &AverageArgs) -> Result<()> {
         ..pem::PemConfig::default()
     };
     let rep = merge::compare(&recs, &val, None, &cfg).map_err(|e| match e {
-        merge::MergeError::Identification { .. } | merge::MergeError::NoValidation => bad(e),
+        merge::MergeError::Identification { .. }
+        | merge::MergeError::NoValidation
+        | merge::MergeError::CommandSign { .. } => bad(e),
         other => anyhow::Error::new(other),
     })?;
     println!(

@@ -49,6 +49,23 @@ pub enum MergeError {
     /// No validation records.
     #[error("no validation records")]
     NoValidation,
+    /// A record's command (or yaw rate) is signed the other way round from the others'.
+    #[error(
+        "{set} record `{record}` is signed the other way round from the others: {flipped} of \
+         the {of} models identified on the other records simulate it 50 pp or more better \
+         with its command negated; negate its command column (or its yaw-rate column, if that \
+         is the one), so that every record uses one sign convention"
+    )]
+    CommandSign {
+        /// "estimation" or "validation".
+        set: &'static str,
+        /// The record.
+        record: String,
+        /// Models that find it flipped.
+        flipped: usize,
+        /// Models asked.
+        of: usize,
+    },
 }
 
 fn same_structure(models: &[&Model]) -> Result<(), MergeError> {
@@ -334,12 +351,46 @@ fn combination(
     }
 }
 
+/// Refuses a record signed the other way round from the rest ([`MergeError::CommandSign`]):
+/// an estimation record that more than half of the other records' models find flipped
+/// ([`predict::command_flipped`]), or a validation record that more than half of all of
+/// them do. Two estimation records that each find the other flipped are both flagged, the
+/// first named.
+fn check_signs(models: &[Model], records: &[Record], val: &[Record]) -> Result<(), MergeError> {
+    let asked = |rec: &Record, skip: Option<usize>| {
+        let others = (0..models.len()).filter(|j| Some(*j) != skip);
+        let of = others.clone().count();
+        let flipped = others
+            .filter(|&j| predict::command_flipped(&models[j], rec).is_some())
+            .count();
+        (flipped, of)
+    };
+    let sets = records
+        .iter()
+        .enumerate()
+        .map(|(i, r)| ("estimation", r, Some(i)))
+        .chain(val.iter().map(|r| ("validation", r, None)));
+    for (set, rec, skip) in sets {
+        let (flipped, of) = asked(rec, skip);
+        if of > 0 && 2 * flipped > of {
+            return Err(MergeError::CommandSign {
+                set,
+                record: rec.name.clone(),
+                flipped,
+                of,
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Identifies each of `records` alone, combines them by `average` and `merge`, identifies on
 /// all of them at once (`multi`), and validates the three on `validation`.
 ///
 /// # Errors
 /// [`MergeError::NoValidation`] without validation records; [`MergeError::Identification`]
-/// when a per-record or the multi-record identification fails. A failed `merge` (singular
+/// when a per-record or the multi-record identification fails; [`MergeError::CommandSign`]
+/// when a record is signed the other way round from the others. A failed `merge` (singular
 /// covariances) is reported in [`CombineReport::merge_error`].
 pub fn compare(
     records: &[Record],
@@ -365,6 +416,7 @@ pub fn compare(
         })
         .collect::<Result<_, _>>()?;
     let models: Vec<Model> = per_record.iter().map(|r| r.model.clone()).collect();
+    check_signs(&models, records, validation)?;
     let mut combinations = Vec::new();
     let avg = average(&models)?;
     combinations.push(combination(

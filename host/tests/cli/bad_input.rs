@@ -125,6 +125,7 @@ fn bad_input_suite() {
         bad("all-zero trial", "diagnose --model {model} --data {d}/zero.csv --reference {d}/good.csv --json {d}/out-summary.json", &["zero.csv", "constant"]),
         bad("command of the other sign, diagnose", "diagnose --model {d}/csv4.json --data {d}/flipped.csv --reference {d}/good.csv --json {d}/out-summary.json", &["trial record `flipped`", "with the command negated", "negate its command column"]),
         bad("command of the other sign, augment", "augment --model {d}/csv4.json --effect bias --data {d}/flipped.csv --out {d}/out --json {d}/out-summary.json", &["estimation record `flipped`", "negate its command column"]),
+        bad("command of the other sign, average", "average --data {d}/good.csv --data {d}/good2.csv --data {d}/flipped.csv --validate {d}/good.csv --out {d}/out --json {d}/out-summary.json", &["estimation record `flipped`", "signed the other way round"]),
         bad("rudder never moves", "tune --data {d}/good.csv --validate {d}/held.csv --out {d}/out", &["held.csv", "delta_deg", "constant"]),
         bad("yaw rate stuck at zero", "identify --data {d}/stuck.csv --out {d}/out", &["stuck.csv", "r_degps", "constant"]),
         bad("1e-300 yaw rate", "compare --model {model} --data {d}/tiny.csv --json {d}/out-summary.json", &["tiny.csv", "r_degps"]),
