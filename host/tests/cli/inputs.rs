@@ -104,47 +104,39 @@ fn custom_columns_and_units() {
     std::fs::write(d.join("rad.csv"), rad).unwrap();
     let j1 = d.join("deg.json");
     let j2 = d.join("rad.json");
-    let o = run(&[
-        "compare",
-        "--model",
-        m.to_str().unwrap(),
-        "--data",
-        d.join("deg.csv").to_str().unwrap(),
-        "--json",
-        j1.to_str().unwrap(),
-    ]);
-    assert_eq!(code(&o), 0, "{}", stderr(&o));
-    let o = run(&[
-        "compare",
-        "--model",
-        m.to_str().unwrap(),
-        "--data",
-        d.join("rad.csv").to_str().unwrap(),
-        "--col-time",
-        "time",
-        "--col-delta",
-        "rudder",
-        "--col-rate",
-        "rot",
-        "--angle-unit",
-        "rad",
-        "--rate-unit",
-        "radps",
-        "--json",
-        j2.to_str().unwrap(),
-    ]);
-    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let compare = |file: &str, extra: &[&str]| {
+        let (model, data) = (m.to_str().unwrap(), d.join(file));
+        let mut args = vec![
+            "compare",
+            "--model",
+            model,
+            "--data",
+            data.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = run(&args);
+        assert_eq!(code(&o), 0, "{file} {extra:?}: {}", stderr(&o));
+    };
+    compare("deg.csv", &["--json", j1.to_str().unwrap()]);
+    compare(
+        "rad.csv",
+        &[
+            "--col-time",
+            "time",
+            "--col-delta",
+            "rudder",
+            "--col-rate",
+            "rot",
+            "--angle-unit",
+            "rad",
+            "--rate-unit",
+            "radps",
+            "--json",
+            j2.to_str().unwrap(),
+        ],
+    );
     // the speed unit is an option of every reading command (knots, km/h, m/s)
-    let o = run(&[
-        "compare",
-        "--model",
-        m.to_str().unwrap(),
-        "--data",
-        d.join("deg.csv").to_str().unwrap(),
-        "--speed-unit",
-        "kn",
-    ]);
-    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    compare("deg.csv", &["--speed-unit", "kn"]);
     let a: serde_json::Value = serde_json::from_slice(&std::fs::read(j1).unwrap()).unwrap();
     let b: serde_json::Value = serde_json::from_slice(&std::fs::read(j2).unwrap()).unwrap();
     for h in ["1", "5", "10", "20", "sim"] {
