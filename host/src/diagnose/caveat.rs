@@ -103,6 +103,17 @@ pub enum Caveat {
         /// (each in words; empty when the reference shows none).
         hull: Vec<String>,
     },
+    /// The trials ran at another speed through the water than the reference, by
+    /// [`OTHER_SPEED`] or more of the reference's, and by more than the smallest current the
+    /// ground track can show ([`Caveat::CurrentResolution`]): a hull's rudder gain and time
+    /// constants change with speed, which the library's effects can only mimic.
+    OtherSpeed {
+        /// The trials' speed straight ahead through the water (m/s): speed over ground less
+        /// the current its heading harmonics show and the speed lost in turns.
+        trials_mps: f64,
+        /// The reference's (m/s).
+        reference_mps: f64,
+    },
     /// A significant effect that does not improve held-out prediction was named behind
     /// the verdict by the ranking rule.
     PassedOver {
@@ -165,6 +176,20 @@ impl Caveat {
                 }
                 w
             }
+            Caveat::OtherSpeed {
+                trials_mps,
+                reference_mps,
+            } => format!(
+                "The trials ran straight at {} m/s through the water and the reference at {} \
+                 m/s ({:+.0} %; speed over ground less the current its heading harmonics show \
+                 and the speed lost in turns): a hull's rudder gain and time constants change \
+                 with speed, and the library's effects can only mimic that, so an angle limit, \
+                 a dead band, an asymmetry or damping named here may be the speed. Sail the \
+                 reference at the trials' speed (in a ship file, the propeller revolutions).",
+                sig(*trials_mps),
+                sig(*reference_mps),
+                100.0 * (trials_mps / reference_mps - 1.0)
+            ),
             Caveat::NoReference => "No reference records were given, so every statistic is \
                 judged against the model alone: hull nonlinearity the model never had shows up \
                 as an effect, and the verdict is weaker."
@@ -328,6 +353,25 @@ pub(super) fn caveats(
         out.push(Caveat::NoSpeedOverGround);
     }
     out
+}
+
+/// Relative difference of the trials' and the reference's speed through the water from which
+/// [`Caveat::OtherSpeed`] is given. On the cross-world suite's PRBS trials with hidden
+/// currents (up to 1.4 m/s), winds or nothing hidden (45 sets, their own seeds and noise) the
+/// two differ by at most 5.7 %; the built-in ship's trials sailed with the propeller turning
+/// 8.0 instead of 10.5 rev/s, by 24 %.
+pub const OTHER_SPEED: f64 = 0.15;
+
+/// [`Caveat::OtherSpeed`] for the speeds `[trials, reference]` when they differ by
+/// [`OTHER_SPEED`] or more, and by more than `resolution` (m/s), the smallest current the
+/// ground track shows (so a current it cannot separate from the speed is not read as one).
+pub(super) fn other_speed(speeds: Option<[f64; 2]>, resolution: f64) -> Option<Caveat> {
+    let [t, r] = speeds?;
+    let differ = r > 0.0 && (t / r - 1.0).abs() >= OTHER_SPEED && (t - r).abs() > resolution;
+    differ.then_some(Caveat::OtherSpeed {
+        trials_mps: t,
+        reference_mps: r,
+    })
 }
 
 /// The sample time [`Caveat::Blocks`] suggests for `sets` (trials, reference, held-out):

@@ -30,6 +30,9 @@ pub(super) struct Channels {
     /// The true wind the anemometer shows, when every record logs it with heading, speed
     /// and course over ground.
     pub(super) anemometer: Option<AnemometerEvidence>,
+    /// The speed through the water straight ahead of the trials and of the reference
+    /// ([`straight_speed`]), when both log heading and speed.
+    pub(super) speeds: Option<[f64; 2]>,
 }
 
 impl Channels {
@@ -65,12 +68,20 @@ impl Channels {
         } else {
             None
         };
+        let speeds = if speed_ok && has_ref {
+            straight_speed(est)
+                .zip(straight_speed(reference))
+                .map(|(t, r)| [t, r])
+        } else {
+            None
+        };
         Channels {
             heading_ok,
             speed_ok,
             hb,
             sog,
             anemometer,
+            speeds,
         }
     }
 }
@@ -217,6 +228,33 @@ fn sog_harmonics(
     taus: &[f64],
     remove: Option<&DVector<f64>>,
 ) -> Option<DVector<f64>> {
+    let beta = sog_fit(lane, recs, heading, shift, taus, remove)?;
+    Some(beta.rows(2 * recs.len(), 4).into_owned())
+}
+
+/// The speed a set of records runs at straight ahead through the water (m/s): the mean of
+/// the per-record intercepts of [`sog_harmonics`]'s fit along the heading — speed over
+/// ground less the current its heading harmonics take, less the speed lost in turns and to
+/// the commands. `None` without heading or speed, or where the fit cannot be made.
+pub(super) fn straight_speed(recs: &[Record]) -> Option<f64> {
+    let refs: Vec<&Record> = recs.iter().collect();
+    let heading = headings(&refs)?;
+    let taus = sog_taus(refs.iter().copied());
+    let beta = sog_fit(Lane::Along, &refs, &heading, &[], &taus, None)?;
+    let u = beta.rows(0, refs.len()).mean();
+    u.is_finite().then_some(u)
+}
+
+/// The whole least-squares fit behind [`sog_harmonics`]: per-record intercepts, per-record
+/// slopes on the heading turned through, the four harmonics, the lane's own regressors.
+fn sog_fit(
+    lane: Lane,
+    recs: &[&Record],
+    heading: &[Heading],
+    shift: &[usize],
+    taus: &[f64],
+    remove: Option<&DVector<f64>>,
+) -> Option<DVector<f64>> {
     let nr = recs.len();
     let taus: &[f64] = match lane {
         Lane::Along => taus,
@@ -299,8 +337,7 @@ fn sog_harmonics(
     for j in 0..p {
         xtx[(j, j)] += ridge;
     }
-    let beta = xtx.cholesky()?.solve(&xty);
-    Some(beta.rows(2 * nr, 4).into_owned())
+    Some(xtx.cholesky()?.solve(&xty))
 }
 
 /// The heading a record has turned through (rad): unwrapped, less its mean over the record.
@@ -840,6 +877,56 @@ mod tests {
         // a missing heading holds the last turn
         let t = turned(&[0.0, f64::NAN, 20.0]);
         assert!((t[1] - t[0]).abs() < 1e-12 && (t[2] - t[1] - 20f64.to_radians()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_speed_straight_ahead_is_speed_over_ground_less_current_and_turns() {
+        // a ship circling slowly at 5 m/s through the water, a 0.8 m/s current from the
+        // north-east carrying it, 0.02 (m/s)/(°/s)² lost to the turn rate (lagged 30 s)
+        let rec = |seed: u64, u0: f64| {
+            let n = 1_800;
+            let mut r = Record::from_uy(
+                &format!("c{seed}"),
+                1.0,
+                (0..n).map(|t| 10.0 * (0.01 * t as f64).sin()).collect(),
+                (0..n)
+                    .map(|t| 0.6 + 0.4 * (0.013 * t as f64 + seed as f64).sin())
+                    .collect(),
+            );
+            let mut psi = 0.0f64;
+            let (mut lag, mut psis, mut sog) = (0.0f64, Vec::new(), Vec::new());
+            for t in 0..n {
+                psis.push(psi.rem_euclid(360.0));
+                lag += (r.y[t] * r.y[t] - lag) / 30.0;
+                let c = 0.8 * (psi - 225.0).to_radians().cos();
+                sog.push(u0 + c - 0.02 * lag);
+                psi += r.y[t];
+            }
+            r.psi = Some(psis);
+            r.speed = Some(sog);
+            r
+        };
+        let set = |u0: f64| (1..=3).map(|s| rec(s, u0)).collect::<Vec<_>>();
+        let u = straight_speed(&set(5.0)).unwrap();
+        assert!((u - 5.0).abs() < 0.05, "{u}");
+        let slow = straight_speed(&set(4.0)).unwrap();
+        assert!((slow - 4.0).abs() < 0.05, "{slow}");
+        // 20 % slower is told (the ground track resolves 0.1 m/s), 5 % is not, nor 20 %
+        // where a current as large could not be told apart
+        let c = crate::diagnose::caveat::other_speed(Some([slow, u]), 0.1).unwrap();
+        assert!(c.explain().contains("(-20 %"), "{}", c.explain());
+        assert_eq!(
+            crate::diagnose::caveat::other_speed(Some([4.8, 5.0]), 0.1),
+            None
+        );
+        assert_eq!(
+            crate::diagnose::caveat::other_speed(Some([slow, u]), 1.5),
+            None
+        );
+        // no heading, no speed
+        let mut bare = set(5.0);
+        bare[1].psi = None;
+        assert_eq!(straight_speed(&bare), None);
     }
 
     /// Zig-zag 20°/20° records of the built-in ship, as `bench/worlds/run.sh
