@@ -213,23 +213,10 @@ const CROSS_TAUS_S: [f64; 4] = [3.0, 10.0, 30.0, 90.0];
 /// Speed over ground (m/s) below which a course is not used.
 const CROSS_MIN_SPEED: f64 = 0.1;
 
-/// Coefficients of (sin ψ, cos ψ, sin 2ψ, cos 2ψ) in the lane's component of the ground
-/// velocity; nuisance: one intercept and one slope on the heading turned through
-/// ([`turned`]) per record, and the lane's own regressors (see [`Lane`]).
-/// `shift[i]` circularly shifts record i's heading against its speed (0: aligned);
-/// `remove` is a heading dependence (coefficients as returned) taken out of the target at the
-/// true heading first, as the null draws do. `heading[i]` is record i's [`Heading`]
-/// (computed once for the many shifted draws of one set).
-fn sog_harmonics(
-    lane: Lane,
-    recs: &[&Record],
-    heading: &[Heading],
-    shift: &[usize],
-    taus: &[f64],
-    remove: Option<&DVector<f64>>,
-) -> Option<DVector<f64>> {
-    let beta = sog_fit(lane, recs, heading, shift, taus, remove)?;
-    Some(beta.rows(2 * recs.len(), 4).into_owned())
+/// The coefficients of (sin ψ, cos ψ, sin 2ψ, cos 2ψ) out of a [`sog_fit`] of `records`
+/// records.
+fn sog_harmonics(beta: DVector<f64>, records: usize) -> DVector<f64> {
+    beta.rows(2 * records, 4).into_owned()
 }
 
 /// The speed a set of records runs at straight ahead through the water (m/s): the mean of
@@ -245,8 +232,15 @@ pub(super) fn straight_speed(recs: &[Record]) -> Option<f64> {
     u.is_finite().then_some(u)
 }
 
-/// The whole least-squares fit behind [`sog_harmonics`]: per-record intercepts, per-record
-/// slopes on the heading turned through, the four harmonics, the lane's own regressors.
+/// The least-squares fit of the lane's component of the ground velocity on the coefficients
+/// of (sin ψ, cos ψ, sin 2ψ, cos 2ψ) and the nuisance: one intercept and one slope on the
+/// heading turned through ([`turned`]) per record, and the lane's own regressors (see
+/// [`Lane`]); all coefficients, in the order intercepts, slopes, harmonics
+/// ([`sog_harmonics`] takes them out), the lane's own.
+/// `shift[i]` circularly shifts record i's heading against its speed (0: aligned);
+/// `remove` is a heading dependence (harmonic coefficients) taken out of the target at the
+/// true heading first, as the null draws do. `heading[i]` is record i's [`Heading`]
+/// (computed once for the many shifted draws of one set).
 fn sog_fit(
     lane: Lane,
     recs: &[&Record],
@@ -449,7 +443,10 @@ fn sog_null_cov(
                 rng.random_range(n / 10..=(9 * n / 10).max(n / 10 + 1))
             })
             .collect();
-        draws.push(sog_harmonics(lane, recs, heading, &sh, taus, Some(own))?);
+        draws.push(sog_harmonics(
+            sog_fit(lane, recs, heading, &sh, taus, Some(own))?,
+            recs.len(),
+        ));
     }
     let m = draws.len() as f64;
     let mean = draws.iter().fold(DVector::zeros(4), |a, b| a + b) / m;
@@ -613,13 +610,16 @@ fn sog_difference(
     rng: &mut ChaCha8Rng,
 ) -> Option<(DVector<f64>, DMatrix<f64>)> {
     let ht = headings(trial)?;
-    let t = sog_harmonics(lane, trial, &ht, &[], taus, None)?;
+    let t = sog_harmonics(sog_fit(lane, trial, &ht, &[], taus, None)?, trial.len());
     let vt = sog_null_cov(lane, trial, &ht, taus, &t, rng)?;
     if reference.is_empty() {
         return Some((t, vt));
     }
     let hr = headings(reference)?;
-    let r = sog_harmonics(lane, reference, &hr, &[], taus, None)?;
+    let r = sog_harmonics(
+        sog_fit(lane, reference, &hr, &[], taus, None)?,
+        reference.len(),
+    );
     let vr = sog_null_cov(lane, reference, &hr, taus, &r, rng)?;
     Some((t - r, vt + vr))
 }
