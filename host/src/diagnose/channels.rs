@@ -7,12 +7,12 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use yawcast_shared::model::EffectKind;
 
+use super::anemometer::{anemometer_evidence, AnemometerEvidence};
 use super::verdict::{cfg_m, Evidence};
 use super::{heading_bias, DiagnoseConfig};
 use crate::effects::{def, Channel};
-use crate::io::data::block_mean;
 use crate::io::data::Record;
-use crate::stats::{chi2_sf, f_quantile, f_sf, normal_sf};
+use crate::stats::{f_quantile, f_sf, normal_sf};
 
 /// What heading and speed over ground show on the trials against the reference: whether
 /// every record logs them, the gyro offset the heading shows (trial minus reference when
@@ -84,113 +84,6 @@ impl Channels {
             speeds,
         }
     }
-}
-
-/// The true wind an anemometer shows: the ship's velocity over ground (speed and course
-/// over ground) less its velocity through the air (the apparent wind, turned from the bow
-/// to north by the heading). A current carries ship and anemometer alike and cancels; the
-/// ship's own motion through still air cancels; what is left is the wind. Its mean over the
-/// trials less its mean over the reference, with block-mean (batch) standard errors per
-/// component (gusts and slow sensor errors are correlated in time), gives a Wald χ² at 2 df
-/// of what lies beyond the instrument's floor ([`ANEMOMETER_FLOOR`] of the ship's speed):
-/// an anemometer's own alignment and calibration errors make a true wind of their own out
-/// of the ship's motion, and a statistic that counted them would find "wind" in any calm.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct AnemometerEvidence {
-    /// Mean true wind, trial minus reference (north, east; m/s, the way it blows).
-    pub(super) wind: [f64; 2],
-    /// Wald χ² (2 df).
-    pub(super) chi: f64,
-    /// Its p-value.
-    pub(super) p: f64,
-    /// The instrument's floor (m/s): a wind up to this is not told from a calm.
-    pub(super) floor: f64,
-}
-
-/// The share of the ship's speed an anemometer cannot tell from a calm: a vane 1° off the
-/// bow line (1.7 %) and a cup reading 2 % off, together.
-const ANEMOMETER_FLOOR: f64 = 0.027;
-
-impl AnemometerEvidence {
-    /// Speed (m/s) and the direction it blows *from* (deg).
-    pub(super) fn speed_from(&self) -> (f64, f64) {
-        let [n, e] = self.wind;
-        (
-            n.hypot(e),
-            (e.atan2(n).to_degrees() + 180.0).rem_euclid(360.0),
-        )
-    }
-}
-
-/// Per-sample true wind (north, east) of a record, `NaN` where the course is missing;
-/// `None` when a channel is not logged.
-fn true_wind(r: &Record) -> Option<[Vec<f64>; 2]> {
-    let (psi, sog, cog) = (r.psi.as_ref()?, r.speed.as_ref()?, r.cog.as_ref()?);
-    let (va, ga) = (r.wind_speed.as_ref()?, r.wind_angle.as_ref()?);
-    let mut out = [Vec::with_capacity(r.len()), Vec::with_capacity(r.len())];
-    for t in 0..r.len() {
-        let (sc, cc) = cog[t].to_radians().sin_cos();
-        let (sg, cg) = ga[t].to_radians().sin_cos();
-        let (sp, cp) = psi[t].to_radians().sin_cos();
-        // the ship's velocity through the air, body axes, then north/east
-        let (ua, wa) = (va[t] * cg, va[t] * sg);
-        let (an, ae) = (ua * cp - wa * sp, ua * sp + wa * cp);
-        out[0].push(sog[t] * cc - an);
-        out[1].push(sog[t] * sc - ae);
-    }
-    Some(out)
-}
-
-/// [`AnemometerEvidence`] of the trials against the reference (against still air when
-/// there is none).
-pub(super) fn anemometer_evidence(
-    trial: &[Record],
-    reference: &[Record],
-) -> Option<AnemometerEvidence> {
-    let stat = |recs: &[Record]| -> Option<[(f64, f64); 2]> {
-        let (mut north, mut east) = (Vec::new(), Vec::new());
-        for r in recs {
-            let [n, e] = true_wind(r)?;
-            north.push(n);
-            east.push(e);
-        }
-        let (mn, sn, _) = block_mean(&north)?;
-        let (me, se, _) = block_mean(&east)?;
-        Some([(mn, sn), (me, se)])
-    };
-    let t = stat(trial)?;
-    let r = if reference.is_empty() {
-        [(0.0, 0.0); 2]
-    } else {
-        stat(reference)?
-    };
-    let wind = [t[0].0 - r[0].0, t[1].0 - r[1].0];
-    // what the instrument cannot tell from a calm: the share of the ship's speed that a
-    // vane 1° off the bow line, or a cup reading 2 % off, makes of its own motion
-    let speed = trial
-        .iter()
-        .filter_map(|r| r.speed.as_ref())
-        .flatten()
-        .sum::<f64>()
-        / trial.iter().map(Record::len).sum::<usize>().max(1) as f64;
-    let floor = ANEMOMETER_FLOOR * speed.abs();
-    let norm = wind[0].hypot(wind[1]);
-    let shrink = if norm > floor {
-        1.0 - floor / norm
-    } else {
-        0.0
-    };
-    let mut chi = 0.0;
-    for k in 0..2 {
-        let se = t[k].1.hypot(r[k].1).max(1e-9);
-        chi += (shrink * wind[k] / se).powi(2);
-    }
-    Some(AnemometerEvidence {
-        wind,
-        chi,
-        p: chi2_sf(chi, 2.0),
-        floor,
-    })
 }
 
 /// Which component of the ground velocity is regressed on the heading harmonics.

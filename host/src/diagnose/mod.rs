@@ -93,6 +93,7 @@
 //! [foreign](Caveat::ForeignModel) to the reference): that one is tested for a *change* on
 //! the trials, the reference's version (the model's own) against the trials' best.
 
+mod anemometer;
 pub mod augment;
 mod caveat;
 mod channels;

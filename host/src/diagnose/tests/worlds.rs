@@ -58,7 +58,7 @@ fn the_anemometer_shows_wind_and_not_a_current() {
     // and its leeway moves the ground track like a current. The anemometer's apparent
     // wind with the ground velocity gives the true wind itself; a current carries ship
     // and anemometer alike and leaves none
-    use super::channels::anemometer_evidence;
+    use super::anemometer::anemometer_evidence;
     use crate::sim::{World, WorldKind};
     let k = WorldKind::Mariner;
     let w = World::new(k, None).unwrap();
