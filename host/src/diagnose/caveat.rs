@@ -106,7 +106,9 @@ pub enum Caveat {
     /// The trials ran at another speed through the water than the reference, by
     /// [`OTHER_SPEED`] or more of the reference's, and by more than the smallest current the
     /// ground track can show ([`Caveat::CurrentResolution`]): a hull's rudder gain and time
-    /// constants change with speed, which the library's effects can only mimic.
+    /// constants change with speed, which the library's effects can only mimic. Given only
+    /// for trials sailed with commands like the reference's (no
+    /// [`Caveat::OtherManoeuvre`]): a zig-zag's straight speed is an extrapolation.
     OtherSpeed {
         /// The trials' speed straight ahead through the water (m/s): speed over ground less
         /// the current its heading harmonics show and the speed lost in turns.

@@ -113,7 +113,7 @@ fn sog_harmonics(beta: DVector<f64>, records: usize) -> DVector<f64> {
 }
 
 /// The speed a set of records runs at straight ahead through the water (m/s): the mean of
-/// the per-record intercepts of [`sog_harmonics`]'s fit along the heading — speed over
+/// the per-record intercepts of the [`sog_fit`] along the heading — speed over
 /// ground less the current its heading harmonics take, less the speed lost in turns and to
 /// the commands. `None` without heading or speed, or where the fit cannot be made.
 pub(super) fn straight_speed(recs: &[Record]) -> Option<f64> {
