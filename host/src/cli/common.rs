@@ -67,6 +67,17 @@ pub enum SpeedUnit {
     Kmh,
 }
 
+impl SpeedUnit {
+    /// What a value in this unit is multiplied by to give m/s.
+    fn to_mps(self) -> f64 {
+        match self {
+            SpeedUnit::Mps => 1.0,
+            SpeedUnit::Kn => 1852.0 / 3600.0,
+            SpeedUnit::Kmh => 1.0 / 3.6,
+        }
+    }
+}
+
 /// File format of a record.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum Format {
@@ -212,11 +223,7 @@ impl ReadArgs {
                 RateUnit::Degps => 1.0,
                 RateUnit::Radps => rad,
             },
-            speed_scale: match self.speed_unit {
-                SpeedUnit::Mps => 1.0,
-                SpeedUnit::Kn => 1852.0 / 3600.0,
-                SpeedUnit::Kmh => 1.0 / 3.6,
-            },
+            speed_scale: self.speed_unit.to_mps(),
             resample: self.resample,
         }
     }
@@ -310,7 +317,7 @@ impl ReadArgs {
             lon: self.col_lon.clone(),
             north: self.col_north.clone(),
             east: self.col_east.clone(),
-            sog_scale: self.columns().speed_scale,
+            sog_scale: self.speed_unit.to_mps(),
         }
     }
 
