@@ -746,7 +746,8 @@ pub fn average(args: &AverageArgs) -> Result<()> {
     let rep = merge::compare(&recs, &val, None, &cfg).map_err(|e| match e {
         merge::MergeError::Identification { .. }
         | merge::MergeError::NoValidation
-        | merge::MergeError::CommandSign { .. } => bad(e),
+        | merge::MergeError::CommandSign { .. }
+        | merge::MergeError::CommandUnit { .. } => bad(e),
         other => anyhow::Error::new(other),
     })?;
     println!(

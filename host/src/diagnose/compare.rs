@@ -106,6 +106,28 @@ pub enum InputError {
         /// Simulation fit (%) with the command negated.
         negated_pct: f64,
     },
+    /// The command of a record is in another unit than the records the model was
+    /// identified on ([`predict::command_other_unit`]).
+    #[error(
+        "{set} record `{record}`: the model simulates it at {given_pct:.1} % fit with the \
+         command as logged and at {scaled_pct:.1} % with the command multiplied by \
+         {scale:.4}, so its command is in another unit than the records the model was \
+         identified on (radians against degrees give 57.3, degrees against radians 0.0175); \
+         give --angle-unit rad for a command in radians, or rescale its command column so \
+         that every record shares the model's unit"
+    )]
+    CommandUnit {
+        /// The set it belongs to ("trial", "reference", …).
+        set: &'static str,
+        /// Record name.
+        record: String,
+        /// Simulation fit (%) with the command as logged.
+        given_pct: f64,
+        /// The factor on the command that simulates the record best.
+        scale: f64,
+        /// Simulation fit (%) with the command multiplied by `scale`.
+        scaled_pct: f64,
+    },
     /// An effect name that is not in the library.
     #[error("unknown effect `{0}`; the library has {names}", names = library_names())]
     UnknownEffect(String),
@@ -201,16 +223,13 @@ pub fn check_inputs(
     Ok(())
 }
 
-/// [`InputError::CommandSign`] for the first record of `recs` whose command is signed the
-/// other way round from the model's records ([`predict::command_flipped`]).
+/// [`InputError::CommandSign`] or [`InputError::CommandUnit`] for the first record of `recs`
+/// whose command is signed the other way round from the model's records
+/// ([`predict::command_flipped`]) or in another unit ([`predict::command_other_unit`]).
 ///
 /// # Errors
-/// [`InputError::CommandSign`] naming the set and record.
-pub fn check_command_sign(
-    model: &Model,
-    recs: &[Record],
-    what: &'static str,
-) -> Result<(), InputError> {
+/// [`InputError::CommandSign`] or [`InputError::CommandUnit`] naming the set and record.
+pub fn check_command(model: &Model, recs: &[Record], what: &'static str) -> Result<(), InputError> {
     for r in recs {
         if let Some((given_pct, negated_pct)) = predict::command_flipped(model, r) {
             return Err(InputError::CommandSign {
@@ -218,6 +237,15 @@ pub fn check_command_sign(
                 record: r.name.clone(),
                 given_pct,
                 negated_pct,
+            });
+        }
+        if let Some(s) = predict::command_other_unit(model, r) {
+            return Err(InputError::CommandUnit {
+                set: what,
+                record: r.name.clone(),
+                given_pct: s.given_pct,
+                scale: s.scale,
+                scaled_pct: s.scaled_pct,
             });
         }
     }

@@ -117,7 +117,7 @@ use thiserror::Error;
 use yawcast_shared::model::EffectKind;
 
 use crate::diagnose::augment::{AugmentConfig, AugmentReport};
-use crate::diagnose::compare::{check_command_sign, check_inputs, mean_fit, InputError};
+use crate::diagnose::compare::{check_command, check_inputs, mean_fit, InputError};
 use crate::effects::GridSpan;
 use crate::identify::model::{Effect, Model};
 use crate::identify::pem::offset::OFFSET_KINDS;
@@ -634,14 +634,14 @@ fn check(
     cfg: &DiagnoseConfig,
 ) -> Result<(), DiagnoseError> {
     check_inputs(model, est, MIN_SAMPLES, "trial")?;
-    check_command_sign(model, est, "trial")?;
+    check_command(model, est, "trial")?;
     if !reference.is_empty() {
         check_inputs(model, reference, MIN_SAMPLES, "reference")?;
-        check_command_sign(model, reference, "reference")?;
+        check_command(model, reference, "reference")?;
     }
     if !val.is_empty() {
         check_inputs(model, val, 4 * model.n + 4, "validation")?;
-        check_command_sign(model, val, "validation")?;
+        check_command(model, val, "validation")?;
     }
     if !(cfg.alpha > 0.0 && cfg.alpha < 1.0) {
         return Err(InputError::Config(format!("alpha {} is not in (0, 1)", cfg.alpha)).into());

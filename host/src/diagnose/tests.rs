@@ -739,3 +739,36 @@ fn the_confirming_refit_fits_the_damping_in_the_form_measured() {
     assert!(measured.cubic(), "{measured:?}");
     assert_eq!(measured.cubic(), refit.cubic(), "{measured:?} {refit:?}");
 }
+
+#[test]
+fn a_command_in_radians_is_refused_and_an_angle_limit_is_not() {
+    use crate::diagnose::compare::check_command;
+    use crate::identify::predict::command_scale;
+    let reference = records(None, &[903, 904, 905]);
+    let model = identify(&reference);
+    // a hidden angle limit makes the rudder look weaker, within the range effects give
+    let sat = records(Some((EffectKind::Saturation, 1.0)), &[431]);
+    let s = command_scale(&model, &sat[0]);
+    assert!(s.scale > 0.3 && s.scale < 0.9, "{s:?}");
+    assert!(check_command(&model, &sat, "trial").is_ok());
+    // the same kind of trial with its rudder logged in radians
+    let mut rad = records(None, &[432]);
+    rad[0].u.iter_mut().for_each(|u| *u = u.to_radians());
+    match check_command(&model, &rad, "trial") {
+        Err(InputError::CommandUnit {
+            record,
+            scale,
+            given_pct,
+            scaled_pct,
+            ..
+        }) => {
+            assert_eq!(record, rad[0].name);
+            assert!((scale - 57.3).abs() < 3.0, "{scale}");
+            assert!(
+                given_pct < 5.0 && scaled_pct > 80.0,
+                "{given_pct} {scaled_pct}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+}

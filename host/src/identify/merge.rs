@@ -66,6 +66,26 @@ pub enum MergeError {
         /// Models asked.
         of: usize,
     },
+    /// A record's command is in another unit than the others'.
+    #[error(
+        "{set} record `{record}` has its command in another unit than the others: {found} of \
+         the {of} models identified on the other records simulate it far better with its \
+         command multiplied by about {scale:.4} (radians against degrees give 57.3, degrees \
+         against radians 0.0175); give --angle-unit rad for a command in radians, or rescale \
+         its command column, so that every record uses one unit"
+    )]
+    CommandUnit {
+        /// "estimation" or "validation".
+        set: &'static str,
+        /// The record.
+        record: String,
+        /// The median factor of the models that find it in another unit.
+        scale: f64,
+        /// Models that find it in another unit.
+        found: usize,
+        /// Models asked.
+        of: usize,
+    },
 }
 
 fn same_structure(models: &[&Model]) -> Result<(), MergeError> {
@@ -351,32 +371,47 @@ fn combination(
     }
 }
 
-/// Refuses a record signed the other way round from the rest ([`MergeError::CommandSign`]):
-/// an estimation record that more than half of the other records' models find flipped
-/// ([`predict::command_flipped`]), or a validation record that more than half of all of
-/// them do. Two estimation records that each find the other flipped are both flagged, the
-/// first named.
+/// Refuses a record signed the other way round from the rest ([`MergeError::CommandSign`])
+/// or with its command in another unit ([`MergeError::CommandUnit`]): an estimation record
+/// that more than half of the other records' models find flipped
+/// ([`predict::command_flipped`]) or in another unit ([`predict::command_other_unit`]), or a
+/// validation record that more than half of all of them do. Two estimation records that each
+/// find the other flipped are both flagged, the first named.
 fn check_signs(models: &[Model], records: &[Record], val: &[Record]) -> Result<(), MergeError> {
-    let asked = |rec: &Record, skip: Option<usize>| {
-        let others = (0..models.len()).filter(|j| Some(*j) != skip);
-        let of = others.clone().count();
-        let flipped = others
-            .filter(|&j| predict::command_flipped(&models[j], rec).is_some())
-            .count();
-        (flipped, of)
-    };
     let sets = records
         .iter()
         .enumerate()
         .map(|(i, r)| ("estimation", r, Some(i)))
         .chain(val.iter().map(|r| ("validation", r, None)));
     for (set, rec, skip) in sets {
-        let (flipped, of) = asked(rec, skip);
+        let others: Vec<&Model> = (0..models.len())
+            .filter(|j| Some(*j) != skip)
+            .map(|j| &models[j])
+            .collect();
+        let of = others.len();
+        let flipped = others
+            .iter()
+            .filter(|m| predict::command_flipped(m, rec).is_some())
+            .count();
         if of > 0 && 2 * flipped > of {
             return Err(MergeError::CommandSign {
                 set,
                 record: rec.name.clone(),
                 flipped,
+                of,
+            });
+        }
+        let mut scales: Vec<f64> = others
+            .iter()
+            .filter_map(|m| predict::command_other_unit(m, rec).map(|s| s.scale))
+            .collect();
+        if of > 0 && 2 * scales.len() > of {
+            scales.sort_by(f64::total_cmp);
+            return Err(MergeError::CommandUnit {
+                set,
+                record: rec.name.clone(),
+                scale: scales[scales.len() / 2],
+                found: scales.len(),
                 of,
             });
         }
@@ -390,7 +425,8 @@ fn check_signs(models: &[Model], records: &[Record], val: &[Record]) -> Result<(
 /// # Errors
 /// [`MergeError::NoValidation`] without validation records; [`MergeError::Identification`]
 /// when a per-record or the multi-record identification fails; [`MergeError::CommandSign`]
-/// when a record is signed the other way round from the others. A failed `merge` (singular
+/// when a record is signed the other way round from the others, [`MergeError::CommandUnit`]
+/// when its command is in another unit. A failed `merge` (singular
 /// covariances) is reported in [`CombineReport::merge_error`].
 pub fn compare(
     records: &[Record],

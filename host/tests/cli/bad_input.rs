@@ -59,6 +59,11 @@ fn bad_input_suite() {
             let d: f64 = c[1].parse().unwrap();
             set(i, i, 1, &format!("{}", -d), l)
         }).into_bytes()),
+        ("radians.csv", rows(&|i, l| {
+            let c: Vec<&str> = l.split(',').collect();
+            let d: f64 = c[1].parse().unwrap();
+            set(i, i, 1, &format!("{}", d.to_radians()), l)
+        }).into_bytes()),
         ("held.csv", rows(&|i, l| set(i, i, 1, "7", l)).into_bytes()),
         ("stuck.csv", rows(&|i, l| set(i, i, 2, "0", l)).into_bytes()),
         ("tiny.csv", rows(&|i, l| set(i, i, 2, &format!("{}e-300", i % 3), l)).into_bytes()),
@@ -126,6 +131,9 @@ fn bad_input_suite() {
         bad("command of the other sign, diagnose", "diagnose --model {d}/csv4.json --data {d}/flipped.csv --reference {d}/good.csv --json {d}/out-summary.json", &["trial record `flipped`", "with the command negated", "negate its command column"]),
         bad("command of the other sign, augment", "augment --model {d}/csv4.json --effect bias --data {d}/flipped.csv --out {d}/out --json {d}/out-summary.json", &["estimation record `flipped`", "negate its command column"]),
         bad("command of the other sign, average", "average --data {d}/good.csv --data {d}/good2.csv --data {d}/flipped.csv --validate {d}/good.csv --out {d}/out --json {d}/out-summary.json", &["estimation record `flipped`", "signed the other way round"]),
+        bad("command in radians, diagnose", "diagnose --model {d}/csv4.json --data {d}/radians.csv --reference {d}/good.csv --json {d}/out-summary.json", &["trial record `radians`", "multiplied by 57.", "another unit", "--angle-unit rad"]),
+        bad("command in radians, augment", "augment --model {d}/csv4.json --effect bias --data {d}/radians.csv --out {d}/out --json {d}/out-summary.json", &["estimation record `radians`", "multiplied by 57."]),
+        bad("command in radians, average", "average --data {d}/good.csv --data {d}/good2.csv --data {d}/radians.csv --validate {d}/good.csv --out {d}/out --json {d}/out-summary.json", &["estimation record `radians`", "another unit", "2 of the 2 models"]),
         bad("rudder never moves", "tune --data {d}/good.csv --validate {d}/held.csv --out {d}/out", &["held.csv", "delta_deg", "constant"]),
         bad("yaw rate stuck at zero", "identify --data {d}/stuck.csv --out {d}/out", &["stuck.csv", "r_degps", "constant"]),
         bad("1e-300 yaw rate", "compare --model {model} --data {d}/tiny.csv --json {d}/out-summary.json", &["tiny.csv", "r_degps"]),

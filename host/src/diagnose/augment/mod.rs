@@ -64,7 +64,7 @@ use serde::{Serialize, Serializer};
 use thiserror::Error;
 use yawcast_shared::model::EffectKind;
 
-use crate::diagnose::compare::{check_command_sign, check_inputs, InputError};
+use crate::diagnose::compare::{check_command, check_inputs, InputError};
 use crate::effects::GridSpan;
 use crate::identify::model::{Effect, Model};
 use crate::identify::pem::{IdentError, PemConfig, PemReport};
@@ -274,10 +274,10 @@ pub fn augment(
 /// Checks the model and the records [`augment`] and [`forward`] are given.
 fn check_records(model: &Model, est: &[Record], val: &[Record]) -> Result<(), AugmentError> {
     check_inputs(model, est, 0, "estimation")?;
-    check_command_sign(model, est, "estimation")?;
+    check_command(model, est, "estimation")?;
     if !val.is_empty() {
         check_inputs(model, val, 0, "validation")?;
-        check_command_sign(model, val, "validation")?;
+        check_command(model, val, "validation")?;
     }
     Ok(())
 }
