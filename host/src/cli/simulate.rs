@@ -47,7 +47,9 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "S")]
     pub ts: Option<f64>,
     /// Command: `prbs` (identification input, random switching, 5–20°), `zigzag:10/10`,
-    /// `step:15` (step at t = 10 s) or `constant:10`.
+    /// `autopilot` (closed-loop course keeping: a PD autopilot, course changes of ±10°
+    /// held 60–180 s, tuned to the hull) or `autopilot:KP/KD/STEP` (heading gain, rate gain
+    /// in s, course change in deg), `step:15` (step at t = 10 s) or `constant:10`.
     #[arg(long, value_name = "KIND", default_value = "prbs")]
     pub input: String,
     /// Rate-gyro noise (deg/s, standard deviation).
@@ -115,7 +117,8 @@ struct Summary {
 fn parse_input(s: &str) -> Result<InputSpec> {
     let err = || {
         bad(format!(
-            "--input {s:?}: expected prbs, zigzag:DELTA/PSI, step:DELTA or constant:DELTA"
+            "--input {s:?}: expected prbs, zigzag:DELTA/PSI, autopilot, autopilot:KP/KD/STEP, \
+             step:DELTA or constant:DELTA"
         ))
     };
     let (kind, arg) = s.split_once(':').unwrap_or((s, ""));
@@ -127,6 +130,28 @@ fn parse_input(s: &str) -> Result<InputSpec> {
             InputSpec::ZigZag {
                 delta_deg: num(d)?,
                 psi_deg: num(p)?,
+            }
+        }
+        "autopilot" if arg.is_empty() => InputSpec::autopilot(),
+        "autopilot" => {
+            let v: Vec<&str> = arg.split('/').collect();
+            let [kp, kd, step] = v[..] else {
+                return Err(err());
+            };
+            let InputSpec::Autopilot {
+                min_hold_s,
+                max_hold_s,
+                ..
+            } = InputSpec::autopilot()
+            else {
+                unreachable!("InputSpec::autopilot is an autopilot")
+            };
+            InputSpec::Autopilot {
+                kp: num(kp)?,
+                kd_s: num(kd)?,
+                step_deg: num(step)?,
+                min_hold_s,
+                max_hold_s,
             }
         }
         "step" => InputSpec::Step {
@@ -242,6 +267,8 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         n_samples,
         input: match parse_input(&args.input)? {
             InputSpec::Prbs { .. } => world.default_input(),
+            // the default autopilot is tuned to the hull's time; given gains stand
+            InputSpec::Autopilot { .. } if args.input == "autopilot" => world.default_autopilot(),
             other => other,
         },
         noise: NoiseSpec {

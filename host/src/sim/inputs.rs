@@ -43,6 +43,24 @@ pub enum InputSpec {
         /// Heading change that triggers the switch (deg, `> 0`).
         psi_deg: f64,
     },
+    /// Closed-loop course keeping, as a ship's autopilot logs it: a PD law
+    /// `δ = −kp·(ψ − ψ_set) − kd_s·r` on the heading and yaw rate, clipped to ±35°, with the
+    /// set course stepping by `step_deg` to either side of the first heading (the side
+    /// alternating) after holds drawn between `min_hold_s` and `max_hold_s`. The command then
+    /// answers the ship's own disturbances (gusts, the background yaw moment), as on a ship
+    /// in service, rather than being chosen beforehand.
+    Autopilot {
+        /// Heading gain (deg of command per deg of heading error, `> 0`).
+        kp: f64,
+        /// Rate gain (deg of command per deg/s of yaw rate, `≥ 0`).
+        kd_s: f64,
+        /// Course change (deg, `> 0`).
+        step_deg: f64,
+        /// Shortest hold of a set course (s).
+        min_hold_s: f64,
+        /// Longest hold of a set course (s).
+        max_hold_s: f64,
+    },
     /// Given commands, one per sample (at least `n_samples` of them).
     Sequence {
         /// Commands (deg).
@@ -60,6 +78,29 @@ impl Default for InputSpec {
         }
     }
 }
+
+impl InputSpec {
+    /// The autopilot of [`InputSpec::Autopilot`] tuned for the built-in ship: heading gain 1,
+    /// rate gain 20 s, course changes of 10° held 60–180 s.
+    ///
+    /// ```
+    /// use yawcast::sim::InputSpec;
+    /// let InputSpec::Autopilot { kp, kd_s, .. } = InputSpec::autopilot() else { panic!() };
+    /// assert_eq!((kp, kd_s), (1.0, 20.0));
+    /// ```
+    pub fn autopilot() -> InputSpec {
+        InputSpec::Autopilot {
+            kp: 1.0,
+            kd_s: 20.0,
+            step_deg: 10.0,
+            min_hold_s: 60.0,
+            max_hold_s: 180.0,
+        }
+    }
+}
+
+/// Largest command the autopilot of [`InputSpec::Autopilot`] gives (deg).
+pub(crate) const AUTOPILOT_MAX_DEG: f64 = 35.0;
 
 /// Random streams of one seed: independent, so changing the noise settings leaves the
 /// input sequence and the initial heading unchanged.
@@ -121,6 +162,30 @@ impl InputSpec {
                 pos("input.delta_deg", *delta_deg)?;
                 pos("input.psi_deg", *psi_deg)
             }
+            InputSpec::Autopilot {
+                kp,
+                kd_s,
+                step_deg,
+                min_hold_s,
+                max_hold_s,
+            } => {
+                pos("input.kp", *kp)?;
+                finite("input.kd_s", *kd_s)?;
+                if *kd_s < 0.0 {
+                    return Err(SimError::invalid("input.kd_s", *kd_s, ">= 0"));
+                }
+                pos("input.step_deg", *step_deg)?;
+                pos("input.min_hold_s", *min_hold_s)?;
+                pos("input.max_hold_s", *max_hold_s)?;
+                if max_hold_s < min_hold_s {
+                    return Err(SimError::invalid(
+                        "input.max_hold_s",
+                        *max_hold_s,
+                        ">= input.min_hold_s",
+                    ));
+                }
+                Ok(())
+            }
             InputSpec::Sequence { delta_deg } => {
                 if delta_deg.len() < n {
                     return Err(SimError::invalid(
@@ -137,7 +202,7 @@ impl InputSpec {
         }
     }
 
-    /// The open-loop command sequence (`None` for the closed-loop zig-zag).
+    /// The open-loop command sequence (`None` for the closed-loop zig-zag and autopilot).
     pub(crate) fn open_loop(&self, n: usize, ts: f64, seed: u64) -> Option<Vec<f64>> {
         match self {
             InputSpec::Prbs {
@@ -157,7 +222,7 @@ impl InputSpec {
                     .collect(),
             ),
             InputSpec::Constant { delta_deg } => Some(vec![*delta_deg; n]),
-            InputSpec::ZigZag { .. } => None,
+            InputSpec::ZigZag { .. } | InputSpec::Autopilot { .. } => None,
             InputSpec::Sequence { delta_deg } => Some(delta_deg[..n].to_vec()),
         }
     }
@@ -179,6 +244,68 @@ fn prbs(n: usize, ts: f64, amps: &[f64], min_hold: f64, max_hold: f64, seed: u64
         sign = -sign;
     }
     out
+}
+
+/// The command of a closed-loop input, decided at each sample from the ship's state.
+#[derive(Debug, Clone)]
+pub(crate) enum Closed {
+    /// [`InputSpec::ZigZag`].
+    ZigZag(ZigZagLogic),
+    /// [`InputSpec::Autopilot`]: the gains and the set course of every sample (relative to
+    /// the first heading, deg).
+    Autopilot {
+        kp: f64,
+        kd_s: f64,
+        set: Vec<f64>,
+        psi0: Option<f64>,
+    },
+}
+
+impl Closed {
+    /// The closed loop of `spec` over `n` samples of `ts` (`None` for an open-loop input).
+    pub(crate) fn of(spec: &InputSpec, n: usize, ts: f64, seed: u64) -> Option<Closed> {
+        match *spec {
+            InputSpec::ZigZag { delta_deg, psi_deg } => {
+                Some(Closed::ZigZag(ZigZagLogic::new(delta_deg, psi_deg)))
+            }
+            InputSpec::Autopilot {
+                kp,
+                kd_s,
+                step_deg,
+                min_hold_s,
+                max_hold_s,
+            } => {
+                // the set course: ±step about the first heading, alternating, PRBS-like holds
+                let side = prbs(n, ts, &[step_deg], min_hold_s, max_hold_s, seed);
+                Some(Closed::Autopilot {
+                    kp,
+                    kd_s,
+                    set: side,
+                    psi0: None,
+                })
+            }
+            _ => None,
+        }
+    }
+
+    /// The command at sample `k` for heading `psi_deg` (unwrapped) and yaw rate `r_degps`.
+    pub(crate) fn command(&mut self, k: usize, psi_deg: f64, r_degps: f64) -> f64 {
+        match self {
+            Closed::ZigZag(z) => z.command(psi_deg),
+            Closed::Autopilot {
+                kp,
+                kd_s,
+                set,
+                psi0,
+            } => {
+                let psi0 = *psi0.get_or_insert(psi_deg);
+                let target = psi0 + set.get(k).or(set.last()).copied().unwrap_or(0.0);
+                let e = psi_deg - target;
+                let d = -*kp * e - *kd_s * r_degps;
+                d.clamp(-AUTOPILOT_MAX_DEG, AUTOPILOT_MAX_DEG)
+            }
+        }
+    }
 }
 
 /// The zig-zag switching logic on heading change (deg).
@@ -261,5 +388,46 @@ mod tests {
         let m = x.iter().sum::<f64>() / x.len() as f64;
         let v = x.iter().map(|a| (a - m).powi(2)).sum::<f64>() / x.len() as f64;
         assert!(m.abs() < 0.03 && (v - 1.0).abs() < 0.05, "{m} {v}");
+    }
+
+    #[test]
+    fn the_autopilot_steers_back_to_its_set_course() {
+        let spec = InputSpec::Autopilot {
+            kp: 2.0,
+            kd_s: 10.0,
+            step_deg: 10.0,
+            min_hold_s: 5.0,
+            max_hold_s: 5.0,
+        };
+        assert!(spec.validate(100).is_ok());
+        assert_eq!(spec.open_loop(100, 1.0, 1), None);
+        let mut c = Closed::of(&spec, 100, 1.0, 1).unwrap();
+        let Closed::Autopilot { set, .. } = &c else {
+            panic!()
+        };
+        // the set course alternates ±10° every 5 s
+        let first = set[0];
+        assert_eq!(first.abs(), 10.0);
+        assert_eq!(set[4], first);
+        assert_eq!(set[5], -first);
+        // the first heading is the base course: δ = −2·(ψ − ψ₀ − set) − 10·r
+        let d0 = c.command(0, 100.0, 0.0);
+        assert_eq!(d0, 2.0 * first);
+        assert_eq!(c.command(1, 100.0 + first, 0.5), -5.0);
+        // clipped to ±35°
+        assert_eq!(c.command(2, 100.0 + first + 30.0, 0.0), -AUTOPILOT_MAX_DEG);
+        // a negative rate gain is refused, named
+        let bad = InputSpec::Autopilot {
+            kp: 1.0,
+            kd_s: -1.0,
+            step_deg: 10.0,
+            min_hold_s: 5.0,
+            max_hold_s: 6.0,
+        };
+        assert!(bad
+            .validate(100)
+            .unwrap_err()
+            .to_string()
+            .contains("input.kd_s"));
     }
 }

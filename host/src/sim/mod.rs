@@ -413,12 +413,7 @@ fn simulate_full(
     };
     let gyro_bias = crate::effects::SimKnobs::of(&effects).gyro_bias_degps;
     let open = scenario.input.open_loop(n, ts, seed);
-    let mut zz = match scenario.input {
-        InputSpec::ZigZag { delta_deg, psi_deg } => {
-            Some(inputs::ZigZagLogic::new(delta_deg, psi_deg))
-        }
-        _ => None,
-    };
+    let mut closed = inputs::Closed::of(&scenario.input, n, ts, seed);
     let mut rec = Record {
         name: scenario.name.clone(),
         ts,
@@ -442,9 +437,9 @@ fn simulate_full(
         warmup_s: scenario.warmup_s,
         psi0_deg: psi0,
     };
-    let mut decide = |k: usize, s: &[f64; NX]| match (&open, zz.as_mut()) {
+    let mut decide = |k: usize, s: &[f64; NX]| match (&open, closed.as_mut()) {
         (Some(u), _) => u[k],
-        (None, Some(z)) => z.command(s[5].to_degrees()),
+        (None, Some(c)) => c.command(k, s[5].to_degrees(), s[2].to_degrees()),
         (None, None) => 0.0,
     };
     let mut states: Vec<([f64; NX], dynamics::Apparent)> = Vec::with_capacity(n);

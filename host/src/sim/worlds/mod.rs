@@ -52,7 +52,7 @@ use rayon::prelude::*;
 use yawcast_shared::model::EffectKind;
 
 use super::dynamics::{self, Model};
-use super::inputs::{self, InputSpec, ZigZagLogic};
+use super::inputs::{self, ZigZagLogic};
 use super::manoeuvres::{TurningTracker, ZigzagTracker};
 use super::{NoiseSpec, Oracle, Scenario, Ship, SimEffect, SimError, TurningResult, ZigzagResult};
 use crate::effects::{HullScale, SimKnobs};
@@ -62,6 +62,7 @@ pub(crate) mod env;
 mod kvlcc2;
 mod mariner;
 mod oracle;
+mod timed;
 
 use env::{gauss_markov, quantise, Sensors, Windage};
 
@@ -237,31 +238,6 @@ impl World {
                 let (l, _, _, u) = lng_reference();
                 (h.lpp() / h.u0()) / (l / u)
             }
-        }
-    }
-
-    /// The identification input: the built-in ship's PRBS-like sequence (amplitudes 5–20°)
-    /// with its holds (5–30 s) stretched by the hull's time `L_pp/U` over the built-in
-    /// ship's, so the ship answers each hold alike.
-    ///
-    /// ```
-    /// use yawcast::sim::{InputSpec, World, WorldKind};
-    /// let lng = World::new(WorldKind::Lng, None).unwrap();
-    /// assert_eq!(lng.default_input(), InputSpec::default());
-    /// ```
-    pub fn default_input(&self) -> InputSpec {
-        let k = self.time_ratio();
-        match InputSpec::default() {
-            InputSpec::Prbs {
-                amplitudes_deg,
-                min_hold_s,
-                max_hold_s,
-            } if self.kind != WorldKind::Lng => InputSpec::Prbs {
-                amplitudes_deg,
-                min_hold_s: (min_hold_s * k).round(),
-                max_hold_s: (max_hold_s * k).round(),
-            },
-            other => other,
         }
     }
 
@@ -709,13 +685,10 @@ fn simulate_hull(
     );
 
     let open = scenario.input.open_loop(n, ts, seed);
-    let mut zz = match scenario.input {
-        InputSpec::ZigZag { delta_deg, psi_deg } => Some(ZigZagLogic::new(delta_deg, psi_deg)),
-        _ => None,
-    };
-    let mut decide = |k: usize, s: &[f64; 6]| match (&open, zz.as_mut()) {
+    let mut closed = inputs::Closed::of(&scenario.input, n, ts, seed);
+    let mut decide = |k: usize, s: &[f64; 6]| match (&open, closed.as_mut()) {
         (Some(u), _) => u[k],
-        (None, Some(z)) => z.command(s[5].to_degrees()),
+        (None, Some(c)) => c.command(k, s[5].to_degrees(), s[2].to_degrees()),
         (None, None) => 0.0,
     };
     let mut cmds = Vec::with_capacity(n);

@@ -1,6 +1,7 @@
 //! Tests of the test worlds: manoeuvres against published trials, every effect's physics,
 //! the shared environment and seeding.
 use super::*;
+use crate::sim::InputSpec;
 
 fn quiet(n: usize, effects: Vec<SimEffect>, w: &World) -> Scenario {
     Scenario {
@@ -428,4 +429,31 @@ fn the_worlds_own_predictor_beats_a_linear_model_of_the_hull() {
     let oracle = o10.fit(&val);
     assert!(oracle > linear + 1.0, "{oracle} vs {linear}");
     assert!(oracle < 100.0);
+}
+
+#[test]
+fn the_autopilot_keeps_every_hull_on_its_set_course() {
+    for kind in [WorldKind::Lng, WorldKind::Kvlcc2, WorldKind::Mariner] {
+        let w = World::new(kind, None).unwrap();
+        let sc = Scenario {
+            input: w.default_autopilot(),
+            ..quiet(1800, Vec::new(), &w)
+        };
+        let r = w.simulate(&sc, 5).unwrap();
+        let psi = r.psi.as_ref().unwrap();
+        // the set course steps ±10° about the first heading: the heading follows it with a
+        // small overshoot, the command moves mostly within a few degrees
+        let dev = psi.iter().map(|p| (p - psi[0]).abs()).fold(0.0, f64::max);
+        let rms = (r.u.iter().map(|u| u * u).sum::<f64>() / r.len() as f64).sqrt();
+        let peak = r.u.iter().fold(0.0f64, |m, u| m.max(u.abs()));
+        println!(
+            "{}: heading within ±{dev:.1}°, command rms {rms:.2}°, peak {peak:.1}°",
+            kind.name()
+        );
+        assert!(dev > 9.0 && dev < 13.0, "{dev}");
+        assert!(rms > 1.0 && rms < 5.0, "{rms}");
+        assert!(peak > 10.0 && peak <= 35.0, "{peak}");
+        // the same seed gives the same record
+        assert_eq!(r, w.simulate(&sc, 5).unwrap());
+    }
 }
