@@ -455,6 +455,56 @@ fn simulate_rejects_bad_arguments_with_exit_2() {
     ]);
     assert_eq!(code(&o), 2);
     assert!(stderr(&o).contains("--input"));
+    // the autopilot takes three numbers, and a negative rate gain is named
+    for (input, says) in [
+        ("autopilot:1/20", "autopilot:KP/KD/STEP"),
+        ("autopilot:1/-3/10", "input.kd_s"),
+    ] {
+        let o = run(&["simulate", "--input", input, "--out", out.to_str().unwrap()]);
+        assert_eq!(code(&o), 2, "{input}");
+        assert!(stderr(&o).contains(says), "{input}: {}", stderr(&o));
+    }
+    // the default autopilot and one with given gains steer the ship: the command answers
+    // the heading (within ±35°), and the given gains change it
+    let ap = d.join("ap.csv");
+    let o = run(&[
+        "simulate",
+        "--world",
+        "mariner",
+        "--input",
+        "autopilot",
+        "--duration",
+        "600",
+        "--seed",
+        "3",
+        "--out",
+        ap.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let given = d.join("ap-given.csv");
+    let o = run(&[
+        "simulate",
+        "--world",
+        "mariner",
+        "--input",
+        "autopilot:2/40/10",
+        "--duration",
+        "600",
+        "--seed",
+        "3",
+        "--out",
+        given.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let peak = |p: &std::path::Path| {
+        yawcast::io::data::read_csv(p)
+            .unwrap()
+            .u
+            .iter()
+            .fold(0.0f64, |m, u| m.max(u.abs()))
+    };
+    let (a, b) = (peak(&ap), peak(&given));
+    assert!(a > 10.0 && a <= 35.0 && b > a, "{a} {b}");
     let o = run(&["simulate", "--ts", "-1", "--out", out.to_str().unwrap()]);
     assert_eq!(code(&o), 2);
     let bad_ship = d.join("bad.toml");
