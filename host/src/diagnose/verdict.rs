@@ -122,7 +122,8 @@ fn yaw_words(ev: &mut Evidence, ts: f64, pct: f64) {
 
 /// The effects ranked (module docs): the significant first, among them those their own
 /// channel shows, each group by likelihood gain above noise; then current or wind decided
-/// ([`current_or_wind`]) and the top two put through the encompassing test ([`encompass`]).
+/// ([`current_or_wind`]) and the top two significant effects put through the encompassing
+/// test ([`encompass`]).
 pub(super) fn rank(
     base: &Model,
     trial: &Set<'_>,
@@ -143,6 +144,12 @@ pub(super) fn rank(
         )
     });
     current_or_wind(ev, level, cfg.alpha, speed, anemometer);
+    // an effect `current_or_wind` left not significant (a wind the anemometer rules out)
+    // leaves the significant effects' ranks, their order kept: the encompassing test is
+    // between the top two significant effects, not a significant one and a discarded one
+    let (sig, rest): (Vec<Evidence>, Vec<Evidence>) = ev.drain(..).partition(|e| e.p < level);
+    ev.extend(sig);
+    ev.extend(rest);
     encompass(
         base,
         trial,

@@ -483,20 +483,30 @@ pub fn command_scale(model: &Model, rec: &Record) -> CommandScale {
     }
 }
 
-/// Factor on a record's command beyond which (or below whose inverse) [`command_other_unit`]
-/// takes the command to be in another unit than the model's records. On the cross-world
-/// suites (PRBS and zig-zag trials, 1 and 4 Hz, every hidden effect; 2 106 records) and the
-/// tank's measured zig-zags against a model of two of them, the best factor lies within
-/// 0.28–1.71: an angle limit or extra damping makes the rudder look weaker, an asymmetry
-/// stronger, a simulation-poor model underestimates its gain. Radians against degrees are
-/// 57.3 and 0.0175.
-pub const OTHER_UNIT_SCALE: f64 = 10.0;
+/// How far (a factor either way) the best factor on a record's command may lie from 57.3 or
+/// from 1/57.3 for [`command_other_unit`] to take the command for radians against a model in
+/// degrees, or degrees against one in radians.
+pub const RADIAN_WINDOW: f64 = 1.5;
 
-/// `rec`'s [`command_scale`] when its command is in another unit than the records `model`
-/// was identified on: the best factor beyond [`OTHER_UNIT_SCALE`] or below its inverse, and
-/// the simulation with it positive and 20 pp or more better than as logged. `None`
-/// otherwise — a factor within the range effects give cannot be told from an effect, and a
-/// negative one is [`command_flipped`]'s.
+/// Simulation fit (%) the command scaled by the best factor must reach for
+/// [`command_other_unit`]: a model that simulates the record well once the unit is right.
+pub const UNIT_SCALED_FIT: f64 = 30.0;
+
+/// `rec`'s [`command_scale`] when its command is in radians against a model identified on
+/// degrees, or the reverse: the best factor within [`RADIAN_WINDOW`] of 57.3 or 1/57.3, the
+/// simulation with it at least [`UNIT_SCALED_FIT`] and 20 pp or more better than as logged.
+/// `None` otherwise.
+///
+/// Effects change the best factor too, but never that far where the scaled simulation is
+/// good: on the cross-world suites (PRBS, zig-zag and autopilot trials, 1 and 4 Hz, every
+/// hidden effect; 2 673 records) and the tank's measured zig-zags against a model of two of
+/// them, every record simulated at 30 % or better has its factor within 0.28–1.71 (an angle
+/// limit makes the rudder look weaker, an asymmetry stronger, a simulation-poor model
+/// underestimates its gain). Where the simulation stays poor at any factor the factor says
+/// nothing: a full dead band under an autopilot, whose small corrections never reach the
+/// ship, gives 0.018 at a fit of 0 %. A factor within the range effects give cannot be told
+/// from an effect (a rudder in per cent of 35° is 0.35), and a negative one is
+/// [`command_flipped`]'s.
 ///
 /// ```
 /// use yawcast::{identify::{model::Model, predict::{self, command_other_unit}}, io::data::Record};
@@ -506,14 +516,19 @@ pub const OTHER_UNIT_SCALE: f64 = 10.0;
 /// let y = predict::simulate(&m, &blank, &[0.0, 0.0]);
 /// let deg = Record::from_uy("r", 0.5, u.clone(), y.clone());
 /// assert_eq!(command_other_unit(&m, &deg), None);
-/// let rad = Record::from_uy("r", 0.5, u.iter().map(|v| v.to_radians()).collect(), y);
+/// let rad = Record::from_uy("r", 0.5, u.iter().map(|v| v.to_radians()).collect(), y.clone());
 /// let s = command_other_unit(&m, &rad).unwrap();
 /// assert!((s.scale - 57.2958).abs() < 1e-3, "{}", s.scale);
+/// // a rudder in per cent of 35°: a factor effects give too, not refused
+/// let pct = Record::from_uy("r", 0.5, u.iter().map(|v| v / 0.35).collect(), y);
+/// assert_eq!(command_other_unit(&m, &pct), None);
 /// ```
 pub fn command_other_unit(model: &Model, rec: &Record) -> Option<CommandScale> {
     let s = command_scale(model, rec);
-    let far = s.scale >= OTHER_UNIT_SCALE || (s.scale > 0.0 && s.scale <= 1.0 / OTHER_UNIT_SCALE);
-    (far && s.scaled_pct >= 0.0 && s.scaled_pct >= s.given_pct + 20.0).then_some(s)
+    let rad = 180.0 / std::f64::consts::PI;
+    let near = |k: f64, at: f64| k > 0.0 && (k / at).ln().abs() <= RADIAN_WINDOW.ln();
+    let unit = near(s.scale, rad) || near(s.scale, 1.0 / rad);
+    (unit && s.scaled_pct >= UNIT_SCALED_FIT && s.scaled_pct >= s.given_pct + 20.0).then_some(s)
 }
 
 #[cfg(test)]
