@@ -80,13 +80,33 @@ impl Null {
     }
 }
 
+/// `sim` with the headings of `real` (record by record, where `real` logs one): the
+/// replicates' heading-dependent regressors at the headings the ship sailed.
+fn sailed(sim: &[Record], real: &[Record]) -> Vec<Record> {
+    sim.iter()
+        .zip(real)
+        .map(|(s, r)| {
+            let mut s = s.clone();
+            if r.psi.is_some() {
+                s.psi.clone_from(&r.psi);
+            }
+            s
+        })
+        .collect()
+}
+
 /// Null replicates of `D` for every kind: parametric bootstrap of the whole procedure. The
 /// innovations model is simulated with its innovation std on the recorded inputs of the
 /// reference and trial records, the model is re-identified on the simulated reference (on the
 /// simulated trials when there is no reference), and `D` is recomputed. With a `generator`
 /// (a model and its innovation std: the hull physics the reference shows of its own, for
 /// trials sailed with other commands) that model is simulated instead, and `model`'s
-/// structure is still what each replicate re-identifies.
+/// structure is still what each replicate re-identifies. The heading-dependent effects
+/// (current, wind) are measured on each replicate at the headings the records sailed, so
+/// their null is conditional on the headings as their statistic is: a replicate replays the
+/// logged commands open loop, and its own heading wanders where an autopilot held the ship
+/// within ±10° — over which a heading harmonic mimics a steady moment, as it does not over
+/// the headings the replicate makes up.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn bootstrap(
     model: &Model,
@@ -100,6 +120,15 @@ pub(super) fn bootstrap(
     seed: u64,
     parallel: bool,
 ) -> Vec<Vec<f64>> {
+    // the heading-dependent effects are measured at the headings sailed, the others on the
+    // replicate's own: a replicate replays the logged commands open loop, so its heading,
+    // integrated from its own rate, wanders where an autopilot held the ship's
+    let (heading_at, plain_at): (Vec<usize>, Vec<usize>) =
+        (0..grids.len()).partition(|&i| grids[i].0.needs_heading());
+    let pick = |at: &[usize]| -> Vec<(EffectKind, Vec<Effect>)> {
+        at.iter().map(|&i| grids[i].clone()).collect()
+    };
+    let (heading, plain) = (pick(&heading_at), pick(&plain_at));
     let one = |r: usize| -> Vec<f64> {
         let mut rng = ChaCha8Rng::seed_from_u64(
             seed.wrapping_mul(0x9E37_79B9_7F4A_7C15)
@@ -124,10 +153,22 @@ pub(super) fn bootstrap(
         let m = pem::identify_from(fit_on, model, &pc)
             .map(|r| r.model)
             .unwrap_or_else(|_| model.clone());
-        let d = world(&m, &rs, &ts, grids, false)
+        let mut d = vec![0.0; grids.len()];
+        for (w, &i) in world(&m, &rs, &ts, &plain, false)
             .into_iter()
-            .map(|w| w.d)
-            .collect();
+            .zip(&plain_at)
+        {
+            d[i] = w.d;
+        }
+        if !heading.is_empty() {
+            let (rs, ts) = (sailed(&rs, reference), sailed(&ts, est));
+            for (w, &i) in world(&m, &rs, &ts, &heading, false)
+                .into_iter()
+                .zip(&heading_at)
+            {
+                d[i] = w.d;
+            }
+        }
         bar.inc(1);
         d
     };
