@@ -119,6 +119,21 @@ pub(crate) fn rng(seed: u64, stream: u64) -> ChaCha8Rng {
 
 pub(crate) use crate::stats::standard_normal as gauss;
 
+/// Checks a pair of holds (s): both positive, the longest no shorter than the shortest.
+fn holds(min_hold_s: f64, max_hold_s: f64) -> Result<(), SimError> {
+    use super::ship::pos;
+    pos("input.min_hold_s", min_hold_s)?;
+    pos("input.max_hold_s", max_hold_s)?;
+    if max_hold_s < min_hold_s {
+        return Err(SimError::invalid(
+            "input.max_hold_s",
+            max_hold_s,
+            ">= input.min_hold_s",
+        ));
+    }
+    Ok(())
+}
+
 impl InputSpec {
     /// Checks the parameters against the run length `n` and sample time `ts`.
     ///
@@ -142,16 +157,7 @@ impl InputSpec {
                 for (i, &a) in amplitudes_deg.iter().enumerate() {
                     pos(&format!("input.amplitudes_deg[{i}]"), a)?;
                 }
-                pos("input.min_hold_s", *min_hold_s)?;
-                pos("input.max_hold_s", *max_hold_s)?;
-                if max_hold_s < min_hold_s {
-                    return Err(SimError::invalid(
-                        "input.max_hold_s",
-                        *max_hold_s,
-                        ">= input.min_hold_s",
-                    ));
-                }
-                Ok(())
+                holds(*min_hold_s, *max_hold_s)
             }
             InputSpec::Step { delta_deg, at_s } => {
                 finite("input.delta_deg", *delta_deg)?;
@@ -175,16 +181,7 @@ impl InputSpec {
                     return Err(SimError::invalid("input.kd_s", *kd_s, ">= 0"));
                 }
                 pos("input.step_deg", *step_deg)?;
-                pos("input.min_hold_s", *min_hold_s)?;
-                pos("input.max_hold_s", *max_hold_s)?;
-                if max_hold_s < min_hold_s {
-                    return Err(SimError::invalid(
-                        "input.max_hold_s",
-                        *max_hold_s,
-                        ">= input.min_hold_s",
-                    ));
-                }
-                Ok(())
+                holds(*min_hold_s, *max_hold_s)
             }
             InputSpec::Sequence { delta_deg } => {
                 if delta_deg.len() < n {
