@@ -82,7 +82,7 @@ impl Null {
 
 /// `sim` with the headings of `real` (record by record, where `real` logs one): the
 /// replicates' heading-dependent regressors at the headings the ship sailed.
-fn sailed(sim: &[Record], real: &[Record]) -> Vec<Record> {
+fn at_headings_sailed(sim: &[Record], real: &[Record]) -> Vec<Record> {
     sim.iter()
         .zip(real)
         .map(|(s, r)| {
@@ -161,7 +161,10 @@ pub(super) fn bootstrap(
             d[i] = w.d;
         }
         if !heading.is_empty() {
-            let (rs, ts) = (sailed(&rs, reference), sailed(&ts, est));
+            let (rs, ts) = (
+                at_headings_sailed(&rs, reference),
+                at_headings_sailed(&ts, est),
+            );
             for (w, &i) in world(&m, &rs, &ts, &heading, false)
                 .into_iter()
                 .zip(&heading_at)

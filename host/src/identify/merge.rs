@@ -377,7 +377,7 @@ fn combination(
 /// ([`predict::command_flipped`]) or in another unit ([`predict::command_other_unit`]), or a
 /// validation record that more than half of all of them do. Two estimation records that each
 /// find the other flipped are both flagged, the first named.
-fn check_signs(models: &[Model], records: &[Record], val: &[Record]) -> Result<(), MergeError> {
+fn check_commands(models: &[Model], records: &[Record], val: &[Record]) -> Result<(), MergeError> {
     let sets = records
         .iter()
         .enumerate()
@@ -452,7 +452,7 @@ pub fn compare(
         })
         .collect::<Result<_, _>>()?;
     let models: Vec<Model> = per_record.iter().map(|r| r.model.clone()).collect();
-    check_signs(&models, records, validation)?;
+    check_commands(&models, records, validation)?;
     let mut combinations = Vec::new();
     let avg = average(&models)?;
     combinations.push(combination(
