@@ -466,44 +466,32 @@ fn simulate_rejects_bad_arguments_with_exit_2() {
     }
     // the default autopilot and one with given gains steer the ship: the command answers
     // the heading (within ±35°), and the given gains change it
-    let ap = d.join("ap.csv");
-    let o = run(&[
-        "simulate",
-        "--world",
-        "mariner",
-        "--input",
-        "autopilot",
-        "--duration",
-        "600",
-        "--seed",
-        "3",
-        "--out",
-        ap.to_str().unwrap(),
-    ]);
-    assert_eq!(code(&o), 0, "{}", stderr(&o));
-    let given = d.join("ap-given.csv");
-    let o = run(&[
-        "simulate",
-        "--world",
-        "mariner",
-        "--input",
-        "autopilot:2/40/10",
-        "--duration",
-        "600",
-        "--seed",
-        "3",
-        "--out",
-        given.to_str().unwrap(),
-    ]);
-    assert_eq!(code(&o), 0, "{}", stderr(&o));
-    let peak = |p: &std::path::Path| {
-        yawcast::io::data::read_csv(p)
+    let peak = |input: &str, name: &str| {
+        let out = d.join(name);
+        let o = run(&[
+            "simulate",
+            "--world",
+            "mariner",
+            "--input",
+            input,
+            "--duration",
+            "600",
+            "--seed",
+            "3",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(code(&o), 0, "{input}: {}", stderr(&o));
+        yawcast::io::data::read_csv(&out)
             .unwrap()
             .u
             .iter()
             .fold(0.0f64, |m, u| m.max(u.abs()))
     };
-    let (a, b) = (peak(&ap), peak(&given));
+    let (a, b) = (
+        peak("autopilot", "ap.csv"),
+        peak("autopilot:2/40/10", "ap-given.csv"),
+    );
     assert!(a > 10.0 && a <= 35.0 && b > a, "{a} {b}");
     let o = run(&["simulate", "--ts", "-1", "--out", out.to_str().unwrap()]);
     assert_eq!(code(&o), 2);

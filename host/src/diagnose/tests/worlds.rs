@@ -38,7 +38,8 @@ fn world_records_with(
 
 /// The records of `sc` on world `w`, the anemometer logged, with gyro, heading and speed
 /// noise `noise` (°/s, °, m/s): the reference as the suite sails it with less noise than the
-/// trials.
+/// trials. The built-in ship's course over ground is its navigation part's, added as
+/// `simulate` writes it beside the record (the anemometer's true wind needs it).
 fn sailed(w: &crate::sim::World, sc: Scenario, noise: [f64; 3], seeds: &[u64]) -> Vec<Record> {
     let sc = Scenario {
         noise: NoiseSpec {
@@ -49,7 +50,19 @@ fn sailed(w: &crate::sim::World, sc: Scenario, noise: [f64; 3], seeds: &[u64]) -
         log_wind: true,
         ..sc
     };
-    w.simulate_many(&sc, seeds).unwrap()
+    if w.kind() != crate::sim::WorldKind::Lng {
+        return w.simulate_many(&sc, seeds).unwrap();
+    }
+    seeds
+        .iter()
+        .map(|&seed| {
+            let (mut r, nav) =
+                crate::sim::simulate_with_nav(&Ship::default_lng(), &sc, seed).unwrap();
+            r.cog = Some(nav.cog_deg);
+            r.name = format!("{}-{seed}", sc.name);
+            r
+        })
+        .collect()
 }
 
 #[test]
@@ -293,11 +306,10 @@ fn a_current_on_long_records_is_read_from_the_records_whole() {
 
 /// The suite's full steady-moment case with autopilot trials on world `kind`: the reference
 /// three PRBS records (seeds 900–902), the trials three autopilot records (100–102), both
-/// with the anemometer and the course over ground (the built-in ship's from its navigation
-/// part, as `simulate` writes it beside the record); the model identified as `yawcast
+/// with the anemometer and the course over ground ([`sailed`]); the model identified as `yawcast
 /// identify` does, with the steady moment the reference shows; diagnosed at seed 1.
 fn autopilot_bias(kind: crate::sim::WorldKind) -> super::Diagnosis {
-    use crate::sim::{simulate_with_nav, InputSpec, World, WorldKind};
+    use crate::sim::{InputSpec, World};
     let w = World::new(kind, None).unwrap();
     let sail = |input: InputSpec, effects: Vec<SimEffect>, noise: [f64; 3], seeds: &[u64]| {
         let sc = Scenario {
@@ -306,27 +318,7 @@ fn autopilot_bias(kind: crate::sim::WorldKind) -> super::Diagnosis {
             effects,
             ..Scenario::default()
         };
-        if kind != WorldKind::Lng {
-            return sailed(&w, sc, noise, seeds);
-        }
-        let sc = Scenario {
-            noise: NoiseSpec {
-                gyro_std_degps: noise[0],
-                heading_std_deg: noise[1],
-                speed_std_mps: noise[2],
-            },
-            log_wind: true,
-            ..sc
-        };
-        seeds
-            .iter()
-            .map(|&seed| {
-                let (mut r, nav) = simulate_with_nav(&Ship::default_lng(), &sc, seed).unwrap();
-                r.cog = Some(nav.cog_deg);
-                r.name = format!("sim-{seed}");
-                r
-            })
-            .collect()
+        sailed(&w, sc, noise, seeds)
     };
     let reference = sail(
         w.default_input(),
