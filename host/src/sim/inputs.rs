@@ -99,6 +99,47 @@ impl InputSpec {
     }
 }
 
+impl InputSpec {
+    /// This input with its times — the holds, the autopilot's rate gain — multiplied by `k`
+    /// and rounded to whole seconds: the same manoeuvre for a hull whose time `L_pp/U` is `k`
+    /// times the built-in ship's. Inputs without such times come back unchanged.
+    ///
+    /// ```
+    /// use yawcast::sim::InputSpec;
+    /// let InputSpec::Prbs { min_hold_s, max_hold_s, .. } = InputSpec::default().stretched(2.04)
+    /// else { panic!() };
+    /// assert_eq!((min_hold_s, max_hold_s), (10.0, 61.0));
+    /// ```
+    pub fn stretched(self, k: f64) -> InputSpec {
+        let t = |s: f64| (s * k).round();
+        match self {
+            InputSpec::Prbs {
+                amplitudes_deg,
+                min_hold_s,
+                max_hold_s,
+            } => InputSpec::Prbs {
+                amplitudes_deg,
+                min_hold_s: t(min_hold_s),
+                max_hold_s: t(max_hold_s),
+            },
+            InputSpec::Autopilot {
+                kp,
+                kd_s,
+                step_deg,
+                min_hold_s,
+                max_hold_s,
+            } => InputSpec::Autopilot {
+                kp,
+                kd_s: t(kd_s),
+                step_deg,
+                min_hold_s: t(min_hold_s),
+                max_hold_s: t(max_hold_s),
+            },
+            other => other,
+        }
+    }
+}
+
 /// Largest command the autopilot of [`InputSpec::Autopilot`] gives (deg).
 pub(crate) const AUTOPILOT_MAX_DEG: f64 = 35.0;
 

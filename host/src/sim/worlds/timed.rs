@@ -14,19 +14,7 @@ impl World {
     /// assert_eq!(lng.default_input(), InputSpec::default());
     /// ```
     pub fn default_input(&self) -> InputSpec {
-        let k = self.time_ratio();
-        match InputSpec::default() {
-            InputSpec::Prbs {
-                amplitudes_deg,
-                min_hold_s,
-                max_hold_s,
-            } if self.kind != WorldKind::Lng => InputSpec::Prbs {
-                amplitudes_deg,
-                min_hold_s: (min_hold_s * k).round(),
-                max_hold_s: (max_hold_s * k).round(),
-            },
-            other => other,
-        }
+        self.timed(InputSpec::default())
     }
 
     /// The autopilot of [`InputSpec::autopilot`] for this hull: its rate gain and its holds
@@ -42,22 +30,16 @@ impl World {
     /// assert!(kd_s > 20.0, "{kd_s}");
     /// ```
     pub fn default_autopilot(&self) -> InputSpec {
-        let k = self.time_ratio();
-        match InputSpec::autopilot() {
-            InputSpec::Autopilot {
-                kp,
-                kd_s,
-                step_deg,
-                min_hold_s,
-                max_hold_s,
-            } if self.kind != WorldKind::Lng => InputSpec::Autopilot {
-                kp,
-                kd_s: (kd_s * k).round(),
-                step_deg,
-                min_hold_s: (min_hold_s * k).round(),
-                max_hold_s: (max_hold_s * k).round(),
-            },
-            other => other,
+        self.timed(InputSpec::autopilot())
+    }
+
+    /// `spec` for this hull: as given on the built-in ship, else stretched by the hull's time
+    /// over the built-in ship's ([`InputSpec::stretched`]).
+    fn timed(&self, spec: InputSpec) -> InputSpec {
+        if self.kind == WorldKind::Lng {
+            spec
+        } else {
+            spec.stretched(self.time_ratio())
         }
     }
 }
