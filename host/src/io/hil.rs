@@ -296,6 +296,9 @@ pub struct Device {
     /// Samples sent ahead before reading answers (QEMU applies flow control on its socket,
     /// so it can take many; a board's UART is read one sample at a time).
     pub window: usize,
+    /// The banner the firmware sent as it booted (under QEMU); `None` on a serial link to
+    /// a firmware that was already running.
+    pub banner: Option<DeviceMessage>,
 }
 
 impl Device {
@@ -390,7 +393,10 @@ impl Device {
         loop {
             match d.recv()? {
                 DeviceMessage::Pong => break,
-                DeviceMessage::Banner { order, .. } => d.order = order,
+                b @ DeviceMessage::Banner { order, .. } => {
+                    d.order = order;
+                    d.banner = Some(b);
+                }
                 other => {
                     return Err(HilError::Protocol {
                         expected: "Pong",
@@ -413,13 +419,15 @@ impl Device {
             order: 0,
             log: None,
             window: 1,
+            banner: None,
         }
     }
 
     fn expect_banner(&mut self) -> Result<(), HilError> {
         match self.recv()? {
-            DeviceMessage::Banner { order, .. } => {
+            b @ DeviceMessage::Banner { order, .. } => {
                 self.order = order;
+                self.banner = Some(b);
                 Ok(())
             }
             other => Err(HilError::Protocol {
@@ -442,19 +450,33 @@ impl Device {
         Ok(())
     }
 
+    /// Queues raw bytes, framed or not (the firmware's tests send it malformed frames so).
+    pub fn send_raw(&mut self, bytes: &[u8]) {
+        self.tx.extend_from_slice(bytes);
+    }
+
+    /// Writes everything queued.
+    ///
+    /// # Errors
+    /// [`HilError::Link`] when the write fails.
+    pub fn flush(&mut self) -> Result<(), HilError> {
+        if !self.tx.is_empty() {
+            self.port
+                .write_all(&self.tx)
+                .and_then(|()| self.port.flush())
+                .map_err(|e| HilError::Link(format!("UART write: {e}")))?;
+            self.tx.clear();
+        }
+        Ok(())
+    }
+
     /// Flushes what is queued and receives the next message.
     ///
     /// # Errors
     /// [`HilError::Link`] on a closed link, a timeout or a bad frame.
     pub fn recv(&mut self) -> Result<DeviceMessage, HilError> {
         let link = |e: String| HilError::Link(e);
-        if !self.tx.is_empty() {
-            self.port
-                .write_all(&self.tx)
-                .and_then(|()| self.port.flush())
-                .map_err(|e| link(format!("UART write: {e}")))?;
-            self.tx.clear();
-        }
+        self.flush()?;
         loop {
             while self.rx_pos < self.rx.len() {
                 let b = self.rx[self.rx_pos];
@@ -602,22 +624,41 @@ impl Device {
         Ok(out)
     }
 
-    /// Ends a QEMU run (`Shutdown`), or just closes a serial link.
-    pub fn close(mut self) {
-        if self.child.is_some() {
-            let _ = self.send(&HostMessage::Shutdown { code: 0 });
-            let _ = self.port.write_all(&self.tx);
-            let _ = self.port.flush();
-            let start = Instant::now();
-            while start.elapsed() < Duration::from_secs(5) {
-                if let Some(c) = self.child.as_mut() {
-                    if let Ok(Some(_)) = c.try_wait() {
-                        self.child = None;
-                        break;
-                    }
-                }
-                std::thread::sleep(Duration::from_millis(20));
+    /// Ends a QEMU run with `Shutdown { code }` and waits (20 s at most) for QEMU to exit;
+    /// returns QEMU's exit code, which the firmware sets to `code` through semihosting.
+    ///
+    /// # Errors
+    /// [`HilError::Link`] on a serial link (a board has no semihosting exit), when the
+    /// message cannot be written, or when QEMU does not exit in time.
+    pub fn shutdown(mut self, code: u8) -> Result<i32, HilError> {
+        if self.child.is_none() {
+            return Err(HilError::Link(
+                "Shutdown ends a QEMU run; a board on a serial link has no exit".into(),
+            ));
+        }
+        self.send(&HostMessage::Shutdown { code })?;
+        self.flush()?;
+        let start = Instant::now();
+        while let Some(c) = self.child.as_mut() {
+            if let Some(st) = c
+                .try_wait()
+                .map_err(|e| HilError::Link(format!("waiting for QEMU: {e}")))?
+            {
+                self.child = None;
+                return Ok(st.code().unwrap_or(-1));
             }
+            if start.elapsed() > Duration::from_secs(20) {
+                return Err(HilError::Link("QEMU did not exit after Shutdown".into()));
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        Err(HilError::Link("QEMU is not running".into()))
+    }
+
+    /// Ends a QEMU run (`Shutdown`), or just closes a serial link.
+    pub fn close(self) {
+        if self.child.is_some() {
+            let _ = self.shutdown(0);
         }
     }
 }
