@@ -9,7 +9,9 @@ use rayon::prelude::*;
 use serde::Serialize;
 use yawcast::io::data::Record;
 use yawcast::io::nav::csv_text_with_nav;
-use yawcast::sim::{self, InputSpec, NoiseSpec, Scenario, Ship, SimEffect, World, WorldKind};
+use yawcast::sim::{
+    self, Autopilot, InputSpec, NoiseSpec, Scenario, Ship, SimEffect, World, WorldKind,
+};
 use yawcast_shared::model::EffectKind;
 
 use super::common::{bad, JsonArg, Outputs, SeedArg};
@@ -138,21 +140,12 @@ fn parse_input(s: &str) -> Result<InputSpec> {
             let [kp, kd, step] = v[..] else {
                 return Err(err());
             };
-            let InputSpec::Autopilot {
-                min_hold_s,
-                max_hold_s,
-                ..
-            } = InputSpec::autopilot()
-            else {
-                unreachable!("InputSpec::autopilot is an autopilot")
-            };
-            InputSpec::Autopilot {
+            InputSpec::Autopilot(Autopilot {
                 kp: num(kp)?,
                 kd_s: num(kd)?,
                 step_deg: num(step)?,
-                min_hold_s,
-                max_hold_s,
-            }
+                ..Autopilot::default()
+            })
         }
         "step" => InputSpec::Step {
             delta_deg: num(arg)?,
@@ -268,7 +261,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         input: match parse_input(&args.input)? {
             InputSpec::Prbs { .. } => world.default_input(),
             // the default autopilot is tuned to the hull's time; given gains stand
-            InputSpec::Autopilot { .. } if args.input == "autopilot" => world.default_autopilot(),
+            InputSpec::Autopilot(_) if args.input == "autopilot" => world.default_autopilot(),
             other => other,
         },
         noise: NoiseSpec {

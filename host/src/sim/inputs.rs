@@ -49,18 +49,7 @@ pub enum InputSpec {
     /// alternating) after holds drawn between `min_hold_s` and `max_hold_s`. The command then
     /// answers the ship's own disturbances (gusts, the background yaw moment), as on a ship
     /// in service, rather than being chosen beforehand.
-    Autopilot {
-        /// Heading gain (deg of command per deg of heading error, `> 0`).
-        kp: f64,
-        /// Rate gain (deg of command per deg/s of yaw rate, `≥ 0`).
-        kd_s: f64,
-        /// Course change (deg, `> 0`).
-        step_deg: f64,
-        /// Shortest hold of a set course (s).
-        min_hold_s: f64,
-        /// Longest hold of a set course (s).
-        max_hold_s: f64,
-    },
+    Autopilot(Autopilot),
     /// Given commands, one per sample (at least `n_samples` of them).
     Sequence {
         /// Commands (deg).
@@ -79,23 +68,62 @@ impl Default for InputSpec {
     }
 }
 
-impl InputSpec {
-    /// The autopilot of [`InputSpec::Autopilot`] tuned for the built-in ship: heading gain 1,
-    /// rate gain 20 s, course changes of 10° held 60–180 s.
-    ///
-    /// ```
-    /// use yawcast::sim::InputSpec;
-    /// let InputSpec::Autopilot { kp, kd_s, .. } = InputSpec::autopilot() else { panic!() };
-    /// assert_eq!((kp, kd_s), (1.0, 20.0));
-    /// ```
-    pub fn autopilot() -> InputSpec {
-        InputSpec::Autopilot {
+/// The course-keeping law and schedule of [`InputSpec::Autopilot`] (in a scenario file its
+/// fields sit beside `kind = "autopilot"`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Autopilot {
+    /// Heading gain (deg of command per deg of heading error, `> 0`).
+    pub kp: f64,
+    /// Rate gain (deg of command per deg/s of yaw rate, `≥ 0`).
+    pub kd_s: f64,
+    /// Course change (deg, `> 0`).
+    pub step_deg: f64,
+    /// Shortest hold of a set course (s).
+    pub min_hold_s: f64,
+    /// Longest hold of a set course (s).
+    pub max_hold_s: f64,
+}
+
+impl Default for Autopilot {
+    /// Tuned for the built-in ship: heading gain 1, rate gain 20 s, course changes of 10°
+    /// held 60–180 s.
+    fn default() -> Self {
+        Autopilot {
             kp: 1.0,
             kd_s: 20.0,
             step_deg: 10.0,
             min_hold_s: 60.0,
             max_hold_s: 180.0,
         }
+    }
+}
+
+impl Autopilot {
+    /// Checks the gains and the schedule, naming the field (`input.kd_s`, …).
+    fn validate(&self) -> Result<(), SimError> {
+        use super::ship::{finite, pos};
+        pos("input.kp", self.kp)?;
+        finite("input.kd_s", self.kd_s)?;
+        if self.kd_s < 0.0 {
+            return Err(SimError::invalid("input.kd_s", self.kd_s, ">= 0"));
+        }
+        pos("input.step_deg", self.step_deg)?;
+        holds(self.min_hold_s, self.max_hold_s)
+    }
+}
+
+impl InputSpec {
+    /// The autopilot of [`InputSpec::Autopilot`] tuned for the built-in ship
+    /// ([`Autopilot::default`]).
+    ///
+    /// ```
+    /// use yawcast::sim::InputSpec;
+    /// let InputSpec::Autopilot(a) = InputSpec::autopilot() else { panic!() };
+    /// assert_eq!((a.kp, a.kd_s, a.step_deg), (1.0, 20.0, 10.0));
+    /// ```
+    pub fn autopilot() -> InputSpec {
+        InputSpec::Autopilot(Autopilot::default())
     }
 }
 
@@ -122,19 +150,12 @@ impl InputSpec {
                 min_hold_s: t(min_hold_s),
                 max_hold_s: t(max_hold_s),
             },
-            InputSpec::Autopilot {
-                kp,
-                kd_s,
-                step_deg,
-                min_hold_s,
-                max_hold_s,
-            } => InputSpec::Autopilot {
-                kp,
-                kd_s: t(kd_s),
-                step_deg,
-                min_hold_s: t(min_hold_s),
-                max_hold_s: t(max_hold_s),
-            },
+            InputSpec::Autopilot(a) => InputSpec::Autopilot(Autopilot {
+                kd_s: t(a.kd_s),
+                min_hold_s: t(a.min_hold_s),
+                max_hold_s: t(a.max_hold_s),
+                ..a
+            }),
             other => other,
         }
     }
@@ -209,21 +230,7 @@ impl InputSpec {
                 pos("input.delta_deg", *delta_deg)?;
                 pos("input.psi_deg", *psi_deg)
             }
-            InputSpec::Autopilot {
-                kp,
-                kd_s,
-                step_deg,
-                min_hold_s,
-                max_hold_s,
-            } => {
-                pos("input.kp", *kp)?;
-                finite("input.kd_s", *kd_s)?;
-                if *kd_s < 0.0 {
-                    return Err(SimError::invalid("input.kd_s", *kd_s, ">= 0"));
-                }
-                pos("input.step_deg", *step_deg)?;
-                holds(*min_hold_s, *max_hold_s)
-            }
+            InputSpec::Autopilot(a) => a.validate(),
             InputSpec::Sequence { delta_deg } => {
                 if delta_deg.len() < n {
                     return Err(SimError::invalid(
@@ -260,7 +267,7 @@ impl InputSpec {
                     .collect(),
             ),
             InputSpec::Constant { delta_deg } => Some(vec![*delta_deg; n]),
-            InputSpec::ZigZag { .. } | InputSpec::Autopilot { .. } => None,
+            InputSpec::ZigZag { .. } | InputSpec::Autopilot(_) => None,
             InputSpec::Sequence { delta_deg } => Some(delta_deg[..n].to_vec()),
         }
     }
@@ -306,18 +313,12 @@ impl Closed {
             InputSpec::ZigZag { delta_deg, psi_deg } => {
                 Some(Closed::ZigZag(ZigZagLogic::new(delta_deg, psi_deg)))
             }
-            InputSpec::Autopilot {
-                kp,
-                kd_s,
-                step_deg,
-                min_hold_s,
-                max_hold_s,
-            } => {
+            InputSpec::Autopilot(a) => {
                 // the set course: ±step about the first heading, alternating, PRBS-like holds
-                let side = prbs(n, ts, &[step_deg], min_hold_s, max_hold_s, seed);
+                let side = prbs(n, ts, &[a.step_deg], a.min_hold_s, a.max_hold_s, seed);
                 Some(Closed::Autopilot {
-                    kp,
-                    kd_s,
+                    kp: a.kp,
+                    kd_s: a.kd_s,
                     set: side,
                     psi0: None,
                 })
@@ -429,14 +430,39 @@ mod tests {
     }
 
     #[test]
+    fn an_autopilot_reads_from_a_scenario_file_with_its_fields_beside_the_kind() {
+        let spec: InputSpec = toml::from_str(
+            "kind = \"autopilot\"\nkp = 2.0\nkd_s = 10.0\nstep_deg = 5.0\n\
+             min_hold_s = 30.0\nmax_hold_s = 90.0\n",
+        )
+        .unwrap();
+        let want = Autopilot {
+            kp: 2.0,
+            kd_s: 10.0,
+            step_deg: 5.0,
+            min_hold_s: 30.0,
+            max_hold_s: 90.0,
+        };
+        assert_eq!(spec, InputSpec::Autopilot(want));
+        assert_eq!(
+            toml::to_string(&spec).unwrap().lines().next(),
+            Some("kind = \"autopilot\"")
+        );
+        let typo = "kind = \"autopilot\"\nkp = 1.0\nkd = 1.0\nkd_s = 1.0\nstep_deg = 5.0\n\
+                    min_hold_s = 30.0\nmax_hold_s = 90.0\n";
+        let e = toml::from_str::<InputSpec>(typo).unwrap_err().to_string();
+        assert!(e.contains("unknown field `kd`"), "{e}");
+    }
+
+    #[test]
     fn the_autopilot_steers_back_to_its_set_course() {
-        let spec = InputSpec::Autopilot {
+        let spec = InputSpec::Autopilot(Autopilot {
             kp: 2.0,
             kd_s: 10.0,
             step_deg: 10.0,
             min_hold_s: 5.0,
             max_hold_s: 5.0,
-        };
+        });
         assert!(spec.validate(100).is_ok());
         assert_eq!(spec.open_loop(100, 1.0, 1), None);
         let mut c = Closed::of(&spec, 100, 1.0, 1).unwrap();
@@ -455,13 +481,10 @@ mod tests {
         // clipped to ±35°
         assert_eq!(c.command(2, 100.0 + first + 30.0, 0.0), -AUTOPILOT_MAX_DEG);
         // a negative rate gain is refused, named
-        let bad = InputSpec::Autopilot {
-            kp: 1.0,
+        let bad = InputSpec::Autopilot(Autopilot {
             kd_s: -1.0,
-            step_deg: 10.0,
-            min_hold_s: 5.0,
-            max_hold_s: 6.0,
-        };
+            ..Autopilot::default()
+        });
         assert!(bad
             .validate(100)
             .unwrap_err()

@@ -55,7 +55,7 @@ pub use crate::effects::{
     HIDDEN_DEAD_TIME_S, HIDDEN_GYRO_BIAS_DEGPS, HIDDEN_LIMIT_DEG, HIDDEN_N_RR, HIDDEN_RATE_DEGPS,
     HIDDEN_WIND_MPS,
 };
-pub use inputs::InputSpec;
+pub use inputs::{Autopilot, InputSpec};
 pub use manoeuvres::{turning_circle, zigzag, TurningResult, ZigzagResult};
 pub use oracle::{simulate_with_oracle, Oracle};
 pub use ship::{

@@ -25,9 +25,9 @@ impl World {
     /// use yawcast::sim::{InputSpec, World, WorldKind};
     /// let lng = World::new(WorldKind::Lng, None).unwrap();
     /// assert_eq!(lng.default_autopilot(), InputSpec::autopilot());
-    /// let InputSpec::Autopilot { kd_s, .. } =
+    /// let InputSpec::Autopilot(a) =
     ///     World::new(WorldKind::Kvlcc2, None).unwrap().default_autopilot() else { panic!() };
-    /// assert!(kd_s > 20.0, "{kd_s}");
+    /// assert!(a.kd_s > 20.0, "{}", a.kd_s);
     /// ```
     pub fn default_autopilot(&self) -> InputSpec {
         self.timed(InputSpec::autopilot())
