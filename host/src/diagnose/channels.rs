@@ -99,7 +99,7 @@ impl Channels {
     /// [`MIN_HEADING_SEPARATION`]. `true` where the heading is not logged (the yaw model
     /// then integrates its own, and nothing here can be judged).
     pub(super) fn yaw_tells_heading(&self) -> bool {
-        self.separation.is_none_or(|s| s >= MIN_HEADING_SEPARATION)
+        !matches!(self.separation, Some(s) if s < MIN_HEADING_SEPARATION)
     }
 }
 
