@@ -195,16 +195,13 @@ fn course_over_ground_shows_a_current_a_tanker_turns_too_slowly_for() {
     );
 }
 
-#[test]
-fn zig_zag_trials_against_a_prbs_reference_are_judged_with_the_hulls_own_physics() {
-    // KVLCC2 at full scale, effect-free ±20° zig-zags against its PRBS reference: at the
-    // zig-zag's turn rates the linear model meets the hull's own nonlinearity as it never
-    // does on the reference, and with nulls simulated from the linear model the trials read
-    // as a dead band or nonlinear damping (`bench/worlds/run.sh --trial-input zigzag:20/20`:
-    // 3 of 3 seeds). The nulls now simulate the hull physics the reference shows of its own
-    use crate::sim::{InputSpec, World, WorldKind};
-    // as the suite sails them: the reference with less noise than the trials
-    let w = World::new(WorldKind::Kvlcc2, None).unwrap();
+/// The suite's effect-free ±20° zig-zag case on world `kind` (`bench/worlds/run.sh
+/// --trial-input zigzag:20/20 --log-wind`): the model identified on three PRBS reference
+/// records (seeds 900–902), the reference, and three zig-zag trials (100–102) with the
+/// trials' noise ([`sailed`]).
+fn zig_zags_against_prbs(kind: crate::sim::WorldKind) -> (Model, Vec<Record>, Vec<Record>) {
+    use crate::sim::{InputSpec, World};
+    let w = World::new(kind, None).unwrap();
     let sail = |input: InputSpec, noise: [f64; 3], seeds: &[u64]| {
         let sc = Scenario {
             n_samples: 1800,
@@ -213,6 +210,7 @@ fn zig_zag_trials_against_a_prbs_reference_are_judged_with_the_hulls_own_physics
         };
         sailed(&w, sc, noise, seeds)
     };
+    // as the suite sails them: the reference with less noise than the trials
     let reference = sail(w.default_input(), [0.02, 0.1, 0.0], &[900, 901, 902]);
     let model = identify(&reference);
     let zigzag = InputSpec::ZigZag {
@@ -220,6 +218,17 @@ fn zig_zag_trials_against_a_prbs_reference_are_judged_with_the_hulls_own_physics
         psi_deg: 20.0,
     };
     let trials = sail(zigzag, [0.03, 0.2, 0.02], &[100, 101, 102]);
+    (model, reference, trials)
+}
+
+#[test]
+fn zig_zag_trials_against_a_prbs_reference_are_judged_with_the_hulls_own_physics() {
+    // KVLCC2 at full scale, effect-free ±20° zig-zags against its PRBS reference: at the
+    // zig-zag's turn rates the linear model meets the hull's own nonlinearity as it never
+    // does on the reference, and with nulls simulated from the linear model the trials read
+    // as a dead band or nonlinear damping (`bench/worlds/run.sh --trial-input zigzag:20/20`:
+    // 3 of 3 seeds). The nulls now simulate the hull physics the reference shows of its own
+    let (model, reference, trials) = zig_zags_against_prbs(crate::sim::WorldKind::Kvlcc2);
     let cfg = DiagnoseConfig::default();
     let d = diagnose(&model, &reference, &trials, &[], &cfg).unwrap();
     let top: Vec<(&str, f64, f64)> = d
@@ -255,23 +264,7 @@ fn zig_zags_that_each_hold_one_course_are_not_read_as_a_current_from_the_yaw_cha
     // turn, and so is the linear model's mismatch with the hull in every swing. The yaw
     // channel read a current at p = 3.5e-5 (13 % of the 50-step error energy) while the
     // ground velocity showed none (χ² = 3.7, 2 df) and the anemometer no wind
-    use crate::sim::{InputSpec, World, WorldKind};
-    let w = World::new(WorldKind::Lng, None).unwrap();
-    let sail = |input: InputSpec, noise: [f64; 3], seeds: &[u64]| {
-        let sc = Scenario {
-            n_samples: 1800,
-            input,
-            ..Scenario::default()
-        };
-        sailed(&w, sc, noise, seeds)
-    };
-    let reference = sail(w.default_input(), [0.02, 0.1, 0.0], &[900, 901, 902]);
-    let model = identify(&reference);
-    let zigzag = InputSpec::ZigZag {
-        delta_deg: 20.0,
-        psi_deg: 20.0,
-    };
-    let trials = sail(zigzag, [0.03, 0.2, 0.02], &[100, 101, 102]);
+    let (model, reference, trials) = zig_zags_against_prbs(crate::sim::WorldKind::Lng);
     let sep = super::super::channels::heading_separation(&trials).unwrap();
     assert!(sep < 0.005, "{sep}");
     let cfg = DiagnoseConfig {
