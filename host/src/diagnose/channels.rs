@@ -8,6 +8,7 @@ use rand_chacha::ChaCha8Rng;
 use yawcast_shared::model::EffectKind;
 
 use super::anemometer::{anemometer_evidence, AnemometerEvidence};
+use super::separation::{heading_separation, MIN_HEADING_SEPARATION};
 use super::verdict::{cfg_m, Evidence};
 use super::{heading_bias, DiagnoseConfig};
 use crate::effects::{def, Channel};
@@ -33,8 +34,7 @@ pub(super) struct Channels {
     /// The speed through the water straight ahead of the trials and of the reference
     /// ([`straight_speed`]), when both log heading and speed.
     pub(super) speeds: Option<[f64; 2]>,
-    /// How far the trials' headings separate a heading harmonic from each record's own
-    /// offset and turn ([`heading_separation`]), when every trial logs its heading.
+    /// The trials' [`heading_separation`], when every trial logs its heading.
     pub(super) separation: Option<f64>,
 }
 
@@ -94,96 +94,11 @@ impl Channels {
         }
     }
 
-    /// Whether the trials' headings let the yaw channel tell a heading-dependent moment
-    /// (current, wind) from the manoeuvre: [`heading_separation`] at least
-    /// [`MIN_HEADING_SEPARATION`]. `true` where the heading is not logged (the yaw model
-    /// then integrates its own, and nothing here can be judged).
+    /// Whether the yaw channel can tell current or wind from the trials' manoeuvre: their
+    /// [`heading_separation`] at least [`MIN_HEADING_SEPARATION`] (or no heading logged).
     pub(super) fn yaw_tells_heading(&self) -> bool {
         !matches!(self.separation, Some(s) if s < MIN_HEADING_SEPARATION)
     }
-}
-
-/// The least share of the heading harmonics' variance over which the yaw channel's
-/// heading-dependent moment counts ([`heading_separation`]): what three records keep that
-/// each sweep their heading evenly through ±40° about their own course (a sine sweep:
-/// ±20° keeps 0.05 %, ±45° 1.1 %, ±90° 13 %).
-///
-/// Measured on the suite's trial sets (`bench/worlds/run.sh`, three worlds, 189 sets each):
-/// ±20° zig-zags 0.07–1.2 %, 185 of 189 under the level (the four above it a slow gear's
-/// or a dead time's wider swings); PRBS trials 0.35–88 %, one of 189 under it (KVLCC2 with
-/// nonlinear damping hidden, its turns held small); the autopilot's course changes under
-/// 0.01 %. The level is a geometry — how far a record must turn for its curvature to show —
-/// and no world's verdicts chose it.
-pub(super) const MIN_HEADING_SEPARATION: f64 = 0.005;
-
-/// How far a set of records' headings separate the heading harmonics (sin ψ, cos ψ) from
-/// what each record's own manoeuvre does: the least share, over directions, of the
-/// harmonics' variance (about their mean over the set) left once each record's own offset
-/// and a slope on its heading turned through ([`turned`]) are taken out. `None` without
-/// headings or samples.
-///
-/// Why: over a record that holds one course — a zig-zag about its first heading, an
-/// autopilot's ±10° — a harmonic is that record's offset plus a slope on how far the ship
-/// has turned, and so is the linear model's mismatch with the hull in every swing of the
-/// manoeuvre, which no current or wind causes (the built-in ship's effect-free ±20°
-/// zig-zags: a current on the yaw channel at p = 3.5·10⁻⁵ with the ground velocity at
-/// χ² = 3.7 on 2 df and the anemometer showing no wind). Only what is left beyond those
-/// tells a heading dependence; where that is almost nothing the yaw channel cannot tell
-/// it, and the channels that carry current and wind themselves (the ground velocity, the
-/// anemometer) must.
-pub(super) fn heading_separation(recs: &[Record]) -> Option<f64> {
-    let nr = recs.len();
-    let p = 2 * nr;
-    // per record: intercept, slope on the heading turned; the two harmonics as targets
-    let mut xtx = DMatrix::<f64>::zeros(p, p);
-    let mut xth = DMatrix::<f64>::zeros(p, 2);
-    let mut hth = nalgebra::Matrix2::<f64>::zeros();
-    let mut sum = nalgebra::Vector2::<f64>::zeros();
-    let mut n = 0usize;
-    for (i, r) in recs.iter().enumerate() {
-        let psi = r.psi.as_ref()?;
-        let turn = turned(psi);
-        for (t, &ps) in psi.iter().enumerate() {
-            if !ps.is_finite() {
-                continue;
-            }
-            let ph = ps.to_radians();
-            let h = nalgebra::Vector2::new(ph.sin(), ph.cos());
-            let (a, b) = (i, nr + i);
-            xtx[(a, a)] += 1.0;
-            xtx[(a, b)] += turn[t];
-            xtx[(b, a)] += turn[t];
-            xtx[(b, b)] += turn[t] * turn[t];
-            for k in 0..2 {
-                xth[(a, k)] += h[k];
-                xth[(b, k)] += turn[t] * h[k];
-            }
-            hth += h * h.transpose();
-            sum += h;
-            n += 1;
-        }
-    }
-    if n < 2 * p {
-        return None;
-    }
-    let mean = sum / n as f64;
-    let total = hth - mean * mean.transpose() * n as f64;
-    // what the nuisance explains: Hᵀ X (XᵀX)⁻¹ Xᵀ H (a relative ridge for records that
-    // never turn)
-    let ridge = 1e-12 * (xtx.trace() / p as f64).max(1e-300);
-    for j in 0..p {
-        xtx[(j, j)] += ridge;
-    }
-    let sol = xtx.cholesky()?.solve(&xth);
-    let explained = xth.transpose() * sol;
-    let left = hth - nalgebra::Matrix2::from_fn(|a, b| explained[(a, b)]);
-    // least generalised eigenvalue of (left, total): through total's Cholesky factor
-    let l = total.cholesky()?.l();
-    let li = l.try_inverse()?;
-    let m = li * left * li.transpose();
-    let ev = m.symmetric_eigenvalues();
-    let least = ev[0].min(ev[1]);
-    least.is_finite().then_some(least.max(0.0))
 }
 
 /// Which component of the ground velocity is regressed on the heading harmonics.
@@ -339,7 +254,7 @@ fn sog_fit(
 /// slow fall of speed over its own turning history to the harmonics (KVLCC2: a wind read on
 /// effect-free trials with the anemometer showing none). On records that turn through full
 /// circles the turned heading is a slow trend the harmonics hardly see.
-fn turned(psi: &[f64]) -> Vec<f64> {
+pub(super) fn turned(psi: &[f64]) -> Vec<f64> {
     let mut out = Vec::with_capacity(psi.len());
     let mut acc = 0.0;
     let mut prev = psi.first().copied().unwrap_or(0.0);
@@ -861,43 +776,6 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
 mod tests {
     use super::*;
     use crate::sim::{simulate_with_nav, InputSpec, NoiseSpec, Scenario, Ship};
-
-    #[test]
-    fn only_headings_beyond_each_records_offset_and_turn_separate_the_harmonics() {
-        // three records of 1 000 samples sweeping their heading as a sine of ±`amp`° about
-        // 0°, 120° and 240°
-        let set = |amp: f64| -> Vec<Record> {
-            (0..3)
-                .map(|i| {
-                    let mut r = Record::from_uy("h", 1.0, vec![0.0; 1000], vec![0.0; 1000]);
-                    r.psi = Some(
-                        (0..1000)
-                            .map(|t| {
-                                let psi = 120.0 * f64::from(i) + amp * (0.02 * f64::from(t)).sin();
-                                psi.rem_euclid(360.0)
-                            })
-                            .collect(),
-                    );
-                    r
-                })
-                .collect()
-        };
-        let sep = |amp: f64| heading_separation(&set(amp)).unwrap();
-        // ±20°, a zig-zag's or an autopilot's course: almost nothing beyond offset and turn
-        let narrow = sep(20.0);
-        assert!(narrow < 1e-3, "{narrow}");
-        // ±180°: the harmonics separate
-        let wide = sep(180.0);
-        assert!(wide > 0.2, "{wide}");
-        // the level lies between a ±30° and a ±45° sine sweep
-        assert!(sep(30.0) < MIN_HEADING_SEPARATION && sep(45.0) > MIN_HEADING_SEPARATION);
-        // growing with the sweep
-        assert!(sep(30.0) > narrow && sep(90.0) > sep(45.0));
-        // a record without heading: nothing to judge
-        let mut none = set(20.0);
-        none[1].psi = None;
-        assert_eq!(heading_separation(&none), None);
-    }
 
     #[test]
     fn the_heading_turned_through_is_unwrapped_and_centred() {

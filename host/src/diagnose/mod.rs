@@ -105,6 +105,7 @@ mod reference;
 pub mod resid;
 mod rule;
 mod second;
+mod separation;
 #[cfg(test)]
 pub(crate) mod tests;
 mod verdict;

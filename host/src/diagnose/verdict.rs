@@ -109,7 +109,7 @@ pub(super) fn effect_evidence(
     }
     if kind.needs_heading() && !ch.yaw_tells_heading() {
         // the records each hold one course: the yaw channel's harmonics are each record's
-        // own offset and turn (channels::heading_separation), and only the channels that
+        // own offset and turn (separation::heading_separation), and only the channels that
         // carry current and wind themselves can show them
         ev.p_yaw = 1.0;
         ev.p = 1.0;
@@ -120,7 +120,7 @@ pub(super) fn effect_evidence(
              sweep through ±40° keeps), over which a heading-dependent moment cannot be told \
              from the manoeuvre's own",
             100.0 * ch.separation.unwrap_or(0.0),
-            100.0 * super::channels::MIN_HEADING_SEPARATION
+            100.0 * super::separation::MIN_HEADING_SEPARATION
         ));
     }
     add_channels(&mut ev, has_ref, cfg, ch);

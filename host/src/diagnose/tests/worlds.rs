@@ -265,7 +265,7 @@ fn zig_zags_that_each_hold_one_course_are_not_read_as_a_current_from_the_yaw_cha
     // channel read a current at p = 3.5e-5 (13 % of the 50-step error energy) while the
     // ground velocity showed none (χ² = 3.7, 2 df) and the anemometer no wind
     let (model, reference, trials) = zig_zags_against_prbs(crate::sim::WorldKind::Lng);
-    let sep = super::super::channels::heading_separation(&trials).unwrap();
+    let sep = super::super::separation::heading_separation(&trials).unwrap();
     assert!(sep < 0.005, "{sep}");
     let cfg = DiagnoseConfig {
         seed: 1,
