@@ -5,7 +5,7 @@ use yawcast_shared::model::EffectKind;
 
 use super::channels::Channels;
 use super::rule::{GAIN_PP, NO_GAIN_PP};
-use super::verdict::{effect_phrase, fmt_p, Evidence};
+use super::verdict::{effect_phrase, fmt_p, Evidence, Moment};
 use super::{MIN_SAMPLES, WINDOW, WINDOW_BLOCK};
 use crate::diagnose::augment::sig;
 use crate::io::data::Record;
@@ -62,6 +62,15 @@ pub enum Caveat {
     CurrentOrLeeway {
         /// p-value of the yaw channel's heading-dependent moment (absent: ≥ α).
         p_moment: f64,
+    },
+    /// A current named from speed over ground alone on trials that each hold one course,
+    /// with no anemometer: the yaw channel cannot tell a heading-dependent moment from the
+    /// manoeuvre's own ([`super::separation::heading_separation`]), so nothing in the records
+    /// tells a current from a wind.
+    CurrentOrWind {
+        /// The least share of the heading harmonics' variance the trials keep beyond each
+        /// record's own offset and turn (under [`super::separation::MIN_HEADING_SEPARATION`]).
+        separation: f64,
     },
     /// An angle limit or a dead band named (first or second) on trials whose commands hold
     /// one magnitude — a zig-zag's ±20°: a limit below it and a dead band take the same off
@@ -226,6 +235,16 @@ impl Caveat {
                  records cannot tell a current from the leeway of a wind too weak to turn the \
                  ship; the anemometer's columns (apparent wind speed and angle) would.",
                 fmt_p(*p_moment)
+            ),
+            Caveat::CurrentOrWind { separation } => format!(
+                "The current is seen on the ground track alone, no anemometer is logged, and \
+                 the trials each hold one course (the heading harmonics keep {:.2} % of their \
+                 variance beyond each record's own offset and turn): over them the yaw \
+                 channel cannot tell a moment varying with heading from the manoeuvre's own. \
+                 The records cannot tell a current from a wind; the anemometer's columns, or \
+                 trials on several courses (a zig-zag or a PRBS on each of four headings), \
+                 would.",
+                100.0 * separation
             ),
             Caveat::ClipOrDeadBand {
                 magnitude_deg,
@@ -394,18 +413,26 @@ fn resample_step(sets: [&[Record]; 3]) -> Option<f64> {
     (k > 1 && long).then_some(k as f64 * ts)
 }
 
-/// The caveat for a current named from the ground track alone ([`Caveat::CurrentOrLeeway`]):
-/// of the effects `named` (the verdict's evidence, then its second effect's), a current that
-/// the yaw channel's heading-dependent moment, not an anemometer, set apart from wind
-/// ([`super::verdict::current_or_wind`]), and found absent.
+/// The caveat for a current named from the ground track alone without an anemometer
+/// ([`Caveat::CurrentOrLeeway`], or [`Caveat::CurrentOrWind`] where the yaw channel is not
+/// counted): of the effects `named` (the verdict's evidence, then its second effect's), a
+/// current that the yaw channel's heading-dependent moment set apart from wind
+/// ([`super::verdict::current_or_wind`]) and found absent, or could not (`separation`: the
+/// trials' [`super::separation::heading_separation`]).
 pub(super) fn current_or_leeway<'a>(
     named: impl IntoIterator<Item = &'a Evidence>,
+    separation: Option<f64>,
 ) -> Option<Caveat> {
     named
         .into_iter()
         .filter(|e| e.kind == EffectKind::Current && e.speed_only)
-        .find_map(|e| e.p_moment)
-        .map(|p_moment| Caveat::CurrentOrLeeway { p_moment })
+        .find_map(|e| e.moment)
+        .map(|m| match m {
+            Moment::Tested(p_moment) => Caveat::CurrentOrLeeway { p_moment },
+            Moment::NotCounted => Caveat::CurrentOrWind {
+                separation: separation.unwrap_or(0.0),
+            },
+        })
 }
 
 #[cfg(test)]

@@ -691,8 +691,8 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
                 p_speed = Some(p_sog);
                 let calibration = s.calibration_words(current);
                 // either channel may show it (Bonferroni over the two); only speed over
-                // ground where the yaw channel cannot tell
-                ev.p = if ch.yaw_tells_heading() {
+                // ground where the yaw channel is not counted
+                ev.p = if ev.yaw_counted {
                     (2.0 * p_yaw.min(p_sog)).min(1.0)
                 } else {
                     p_sog
@@ -745,7 +745,7 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
                 // the direct channel: three tests now, Bonferroni over them
                 let (speed, from) = a.speed_from();
                 let p_sog = p_speed.unwrap_or(p_yaw);
-                ev.p = if ch.yaw_tells_heading() {
+                ev.p = if ev.yaw_counted {
                     (3.0 * p_yaw.min(a.p).min(p_sog)).min(1.0)
                 } else {
                     (2.0 * a.p.min(p_sog)).min(1.0)

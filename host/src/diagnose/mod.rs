@@ -592,6 +592,7 @@ pub fn diagnose(
     let verdict_ev = ev.iter().find(|e| e.kind.name() == verdict_name);
     caveats.extend(caveat::current_or_leeway(
         verdict_ev.into_iter().chain(then.as_ref().map(|(e, _)| e)),
+        ch.separation,
     ));
     let named: Vec<EffectKind> = verdict_ev
         .map(|e| e.kind)

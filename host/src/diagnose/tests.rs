@@ -10,7 +10,7 @@ use super::caveat::current_or_leeway;
 use super::channels::{sog_evidence, sog_evidence_with, sog_taus};
 use super::evidence::{trial_statistic, Version};
 use super::null::{simulate_innovations, Null};
-use super::verdict::current_or_wind;
+use super::verdict::{current_or_wind, Moment};
 use super::*;
 use crate::identify::pem::{self, PemConfig};
 use crate::sim::{simulate, NoiseSpec, Scenario, Ship, SimEffect};
@@ -427,6 +427,7 @@ pub(super) fn evidence(kind: EffectKind, p: f64, p_yaw: f64, channel_material: b
         best: Effect::zero(kind, 0.0),
         p,
         p_yaw,
+        yaw_counted: true,
         score: 0.0,
         statistic: 0.0,
         words: String::new(),
@@ -435,7 +436,7 @@ pub(super) fn evidence(kind: EffectKind, p: f64, p_yaw: f64, channel_material: b
         channel_material,
         reference: None,
         speed_only: false,
-        p_moment: None,
+        moment: None,
     }
 }
 
@@ -604,7 +605,7 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
     assert!((ev[0].p - 8e-4).abs() < 1e-15, "{}", ev[0].p);
     assert!(ev[0].channel_material);
     assert!(ev[0].words.contains("present"), "{}", ev[0].words);
-    assert!(current_or_leeway(&ev).is_none());
+    assert!(current_or_leeway(&ev, None).is_none());
     // the same speed evidence without a yaw moment: a current, wind moved behind it
     let mut ev = vec![
         evidence(EffectKind::Wind, 1e-6, 0.3, true),
@@ -616,19 +617,19 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
     // named from the ground track alone, without an anemometer: a caveat says a wind's
     // leeway would look the same, with the p applied (2 × 0.05); none for the wind, none
     // where an anemometer decided
-    let c = current_or_leeway(&ev).unwrap();
+    let c = current_or_leeway(&ev, None).unwrap();
     assert_eq!(c, Caveat::CurrentOrLeeway { p_moment: 0.1 });
     let json = serde_json::to_value(&c).unwrap();
     assert_eq!(json["caveat"], "current-or-leeway");
     assert!(c.explain().contains("p = 1.0e-1"), "{}", c.explain());
-    assert!(current_or_leeway(&ev[1..]).is_none());
+    assert!(current_or_leeway(&ev[1..], None).is_none());
     let mut ev = vec![
         evidence(EffectKind::Current, 1e-7, 0.05, true),
         evidence(EffectKind::Wind, 1e-6, 0.3, true),
     ];
     current_or_wind(&mut ev, level, alpha, true, Some(0.5));
     assert_eq!(kinds(&ev), [EffectKind::Current, EffectKind::Wind]);
-    assert!(current_or_leeway(&ev).is_none());
+    assert!(current_or_leeway(&ev, None).is_none());
     // an anemometer showing no wind outranks a yaw moment varying with heading: the
     // built-in ship's effect-free ±20° zig-zags against its PRBS reference (seed 2) read
     // as wind at p 7.4e-5 from the yaw channel alone, the anemometer's true wind 0.00 m/s
@@ -642,6 +643,48 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
     assert_eq!(ev[1].p, 1.0);
     assert!(!ev[1].channel_material);
     assert!(ev[1].words.contains("(absent)"), "{}", ev[1].words);
+    // trials that each hold one course, no anemometer: the yaw channel is not counted
+    // (effect_evidence set its p to 1), so nothing tells whether the ship is turned. The
+    // current is read from the ground track, and the words and the caveat say the records
+    // cannot tell it from a wind, not that a moment was tested and found absent
+    let gated = |kind, p| Evidence {
+        yaw_counted: false,
+        ..evidence(kind, p, 1.0, true)
+    };
+    let mut ev = vec![
+        gated(EffectKind::Wind, 1e-6),
+        gated(EffectKind::Current, 1e-7),
+    ];
+    current_or_wind(&mut ev, level, alpha, true, None);
+    assert_eq!(kinds(&ev), [EffectKind::Current, EffectKind::Wind]);
+    assert!(ev[0].words.contains("not counted"), "{}", ev[0].words);
+    assert!(!ev[0].words.contains("(absent)"), "{}", ev[0].words);
+    assert_eq!(ev[0].moment, Some(Moment::NotCounted));
+    let c = current_or_leeway(&ev, Some(0.0012)).unwrap();
+    assert_eq!(c, Caveat::CurrentOrWind { separation: 0.0012 });
+    let json = serde_json::to_value(&c).unwrap();
+    assert_eq!(json["caveat"], "current-or-wind");
+    assert!(c.explain().contains("0.12 %"), "{}", c.explain());
+    assert!(
+        c.explain().contains("cannot tell a current from a wind"),
+        "{}",
+        c.explain()
+    );
+    // the same evidence with the yaw channel counted: a moment tested and found absent
+    let mut ev = vec![
+        evidence(EffectKind::Wind, 1e-6, 1.0, true),
+        evidence(EffectKind::Current, 1e-7, 1.0, true),
+    ];
+    current_or_wind(&mut ev, level, alpha, true, None);
+    assert!(
+        ev[0].words.contains("p = 1.0e0 (absent)"),
+        "{}",
+        ev[0].words
+    );
+    assert_eq!(
+        current_or_leeway(&ev, Some(0.0012)),
+        Some(Caveat::CurrentOrLeeway { p_moment: 1.0 })
+    );
     // without speed over ground, or with neither significant, nothing changes
     for (speed, p) in [(false, 1e-7), (true, 0.5)] {
         let mut ev = vec![

@@ -42,8 +42,14 @@ pub(super) struct Evidence {
     pub(super) null: Null,
     pub(super) best: Effect,
     pub(super) p: f64,
-    /// p-value of the yaw channel alone (before any other channel is combined in).
+    /// p-value of the yaw channel alone (before any other channel is combined in); 1 where
+    /// it is not counted.
     pub(super) p_yaw: f64,
+    /// Whether the yaw channel counts: not for an effect that needs heading on trials that
+    /// each hold one course ([`Channels::yaw_tells_heading`]), where its heading harmonics
+    /// are each record's own offset and turn. The one place the gate is read; the other
+    /// channels' combination ([`add_channels`]) and [`current_or_wind`] follow this flag.
+    pub(super) yaw_counted: bool,
     pub(super) score: f64,
     pub(super) statistic: f64,
     pub(super) words: String,
@@ -56,9 +62,19 @@ pub(super) struct Evidence {
     /// Current or wind shown by speed over ground while the yaw channel shows no
     /// heading-dependent moment ([`current_or_wind`]).
     pub(super) speed_only: bool,
-    /// The yaw channel's heading-dependent moment, when it decided between current and wind
-    /// (no anemometer): its p-value ([`current_or_wind`]).
-    pub(super) p_moment: Option<f64>,
+    /// What set a current apart from wind where no anemometer is logged
+    /// ([`current_or_wind`]).
+    pub(super) moment: Option<Moment>,
+}
+
+/// What set a current apart from wind without an anemometer ([`current_or_wind`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Moment {
+    /// The yaw channel's heading-dependent moment decided, with this p-value.
+    Tested(f64),
+    /// Nothing could: the yaw channel is not counted (the trials each hold one course), and
+    /// the records cannot tell whether the ship is turned.
+    NotCounted,
 }
 
 /// One effect kind's evidence: its statistic `D` against its bootstrap null, in words
@@ -88,6 +104,7 @@ pub(super) fn effect_evidence(
         best,
         p: p_yaw,
         p_yaw,
+        yaw_counted: true,
         score: null.excess(d),
         statistic: d,
         words: String::new(),
@@ -96,7 +113,7 @@ pub(super) fn effect_evidence(
         channel_material: false,
         reference: stat.reference,
         speed_only: false,
-        p_moment: None,
+        moment: None,
     };
     let pct = 100.0 * (1.0 - (-d / tn.max(1) as f64).exp());
     yaw_words(&mut ev, ts, pct);
@@ -112,6 +129,7 @@ pub(super) fn effect_evidence(
         // own offset and turn (separation::heading_separation), and only the channels that
         // carry current and wind themselves can show them
         ev.p_yaw = 1.0;
+        ev.yaw_counted = false;
         ev.p = 1.0;
         ev.score = ev.score.min(0.0);
         ev.words.push_str(&format!(
@@ -205,37 +223,53 @@ pub(super) fn current_or_wind(
         return;
     }
     let p_moment = moment_p(&ev[ic], &ev[iw]);
-    // an anemometer measures the wind itself: it decides, the yaw moment does not
+    // without an anemometer the yaw channel decides, where it is counted; on trials that
+    // each hold one course it is not, and nothing tells whether the ship is turned
+    let counted = ev[ic].yaw_counted && ev[iw].yaw_counted;
     let (p_decide, wind) = match anemometer {
         Some(p) => (p, p < alpha),
-        None => (p_moment, p_moment < alpha),
+        None => (p_moment, counted && p_moment < alpha),
     };
-    let (witness, turned, carried) = match anemometer {
-        Some(_) => (
-            "true wind on the anemometer",
-            "the ground track moves with the wind: wind",
-            "no wind moves it, the water carries the ship: a current",
+    let words = match anemometer {
+        Some(_) => format!(
+            "; true wind on the anemometer: p {} ({}): {}",
+            fmt_p(p_decide),
+            if wind { "present" } else { "absent" },
+            if wind {
+                "the ground track moves with the wind: wind"
+            } else {
+                "no wind moves it, the water carries the ship: a current"
+            }
         ),
-        None => (
-            "yaw moment varying with heading",
-            "the ship is turned by it, wind (a current carries the ship without turning it)",
-            "speed over ground alone depends on heading: the ship is set over ground without \
-             being turned, a current",
+        None if !counted => "; yaw moment varying with heading: not counted (the trials each \
+                             hold one course), so the records cannot tell whether the ship is \
+                             turned, nor a current from a wind: read as a current, which sets the \
+                             ship over ground without turning it"
+            .to_string(),
+        None => format!(
+            "; yaw moment varying with heading: p {} ({}): {}",
+            fmt_p(p_decide),
+            if wind { "present" } else { "absent" },
+            if wind {
+                "the ship is turned by it, wind (a current carries the ship without turning it)"
+            } else {
+                "speed over ground alone depends on heading: the ship is set over ground \
+                 without being turned, a current"
+            }
         ),
     };
-    let words = format!(
-        "; {witness}: p {} ({}): {}",
-        fmt_p(p_decide),
-        if wind { "present" } else { "absent" },
-        if wind { turned } else { carried }
-    );
     ev[ic].words.push_str(&words);
     ev[iw].words.push_str(&words);
     ev[ic].speed_only = !wind;
     ev[iw].speed_only = !wind;
     if anemometer.is_none() {
-        ev[ic].p_moment = Some(p_moment);
-        ev[iw].p_moment = Some(p_moment);
+        let m = if counted {
+            Moment::Tested(p_moment)
+        } else {
+            Moment::NotCounted
+        };
+        ev[ic].moment = Some(m);
+        ev[iw].moment = Some(m);
     }
     if wind {
         let heading_p = ev[ic].p.min(ev[iw].p);
