@@ -135,9 +135,12 @@ impl Sink for Accum {
                 continue;
             }
             self.g[i] += ri * e;
+            // indexed, not zipped: the hottest loop of identification, and slices' `zip`
+            // is not always inlined across codegen units (the `ci` profile's tests)
             let h = &mut self.h[i * q + i..i * q + len];
-            for (hj, rj) in h.iter_mut().zip(&row[i..len]) {
-                *hj += ri * rj;
+            let r = &row[i..i + h.len()];
+            for k in 0..h.len() {
+                h[k] += ri * r[k];
             }
         }
     }
