@@ -230,33 +230,32 @@ pub(super) fn current_or_wind(
         Some(p) => (p, p < alpha),
         None => (p_moment, counted && p_moment < alpha),
     };
-    let words = match anemometer {
-        Some(_) => format!(
-            "; true wind on the anemometer: p {} ({}): {}",
+    let (witness, turned, carried) = match anemometer {
+        Some(_) => (
+            "true wind on the anemometer",
+            "the ground track moves with the wind: wind",
+            "no wind moves it, the water carries the ship: a current",
+        ),
+        None => (
+            "yaw moment varying with heading",
+            "the ship is turned by it, wind (a current carries the ship without turning it)",
+            "speed over ground alone depends on heading: the ship is set over ground without \
+             being turned, a current",
+        ),
+    };
+    let words = if anemometer.is_none() && !counted {
+        format!(
+            "; {witness}: not counted (the trials each hold one course), so the records cannot \
+             tell whether the ship is turned, nor a current from a wind: read as a current, \
+             which sets the ship over ground without turning it"
+        )
+    } else {
+        format!(
+            "; {witness}: p {} ({}): {}",
             fmt_p(p_decide),
             if wind { "present" } else { "absent" },
-            if wind {
-                "the ground track moves with the wind: wind"
-            } else {
-                "no wind moves it, the water carries the ship: a current"
-            }
-        ),
-        None if !counted => "; yaw moment varying with heading: not counted (the trials each \
-                             hold one course), so the records cannot tell whether the ship is \
-                             turned, nor a current from a wind: read as a current, which sets the \
-                             ship over ground without turning it"
-            .to_string(),
-        None => format!(
-            "; yaw moment varying with heading: p {} ({}): {}",
-            fmt_p(p_decide),
-            if wind { "present" } else { "absent" },
-            if wind {
-                "the ship is turned by it, wind (a current carries the ship without turning it)"
-            } else {
-                "speed over ground alone depends on heading: the ship is set over ground \
-                 without being turned, a current"
-            }
-        ),
+            if wind { turned } else { carried }
+        )
     };
     ev[ic].words.push_str(&words);
     ev[iw].words.push_str(&words);
