@@ -657,6 +657,9 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
     ];
     current_or_wind(&mut ev, level, alpha, true, None);
     assert_eq!(kinds(&ev), [EffectKind::Current, EffectKind::Wind]);
+    // nothing shows a wind: not significant, whatever its speed harmonics' p
+    assert_eq!(ev[1].p, 1.0);
+    assert!(!ev[1].channel_material);
     assert!(ev[0].words.contains("not counted"), "{}", ev[0].words);
     assert!(!ev[0].words.contains("(absent)"), "{}", ev[0].words);
     assert_eq!(ev[0].moment, Some(Moment::NotCounted));
@@ -670,6 +673,15 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
         "{}",
         c.explain()
     );
+    // the built-in ship's effect-free ±20° zig-zags, no anemometer (seed 2): wind
+    // significant from the speed over ground's second harmonic alone (p = 2.5e-5), the
+    // current not (0.77): wind is not named, and neither is a current
+    let mut ev = vec![
+        gated(EffectKind::Wind, 2.5e-5),
+        gated(EffectKind::Current, 0.77),
+    ];
+    current_or_wind(&mut ev, level, alpha, true, None);
+    assert!(ev.iter().all(|e| e.p >= level), "{ev:?}");
     // the same evidence with the yaw channel counted: a moment tested and found absent
     let mut ev = vec![
         evidence(EffectKind::Wind, 1e-6, 1.0, true),

@@ -207,7 +207,10 @@ pub(super) fn rank(
 /// are (intersection–union: the larger p-value), and material when the speed channel shows
 /// the heading dependence. Where an anemometer decides and shows no wind, wind is not
 /// significant (its p at least the anemometer's): the instrument that measures the wind
-/// outranks a yaw moment that may be anything varying with heading.
+/// outranks a yaw moment that may be anything varying with heading. Where neither can decide
+/// — no anemometer, and the yaw channel not counted on trials that each hold one course
+/// ([`Evidence::yaw_counted`]) — wind is not significant (p = 1): nothing in the records
+/// shows one, and a current is read from the ground track alone ([`Moment::NotCounted`]).
 pub(super) fn current_or_wind(
     ev: &mut Vec<Evidence>,
     level: f64,
@@ -246,8 +249,9 @@ pub(super) fn current_or_wind(
     let words = if anemometer.is_none() && !counted {
         format!(
             "; {witness}: not counted (the trials each hold one course), so the records cannot \
-             tell whether the ship is turned, nor a current from a wind: read as a current, \
-             which sets the ship over ground without turning it"
+             tell whether the ship is turned, nor a current from a wind: wind is not counted, \
+             and a heading dependence of the ground track is read as a current, which sets \
+             the ship over ground without turning it"
         )
     } else {
         format!(
@@ -281,6 +285,15 @@ pub(super) fn current_or_wind(
         // wind's, whatever its own p (on zig-zags the hull's own moment over each swing)
         let w = &mut ev[iw];
         w.p = w.p.max(p_decide);
+        w.channel_material = false;
+    } else if !counted {
+        // nothing shows a wind: what sets wind apart from a current is the yaw moment (not
+        // counted here) or the anemometer (not logged); its remaining evidence, the speed
+        // over ground's heading harmonics, a current or the speed lost in the turns of one
+        // course explains as well (the built-in ship's effect-free ±20° zig-zags without an
+        // anemometer read `wind` at p = 2.5e-5 from the second harmonic alone)
+        let w = &mut ev[iw];
+        w.p = 1.0;
         w.channel_material = false;
     }
     let (win, lose) = if wind { (iw, ic) } else { (ic, iw) };
