@@ -225,6 +225,30 @@ fn zig_zags_against_prbs(kind: crate::sim::WorldKind, s: u64) -> (Model, Vec<Rec
     (model, reference, trials)
 }
 
+/// `diagnose` with the default configuration at `seed`, and the ranking's row of `effect`
+/// (printed with the verdict and the explanation).
+fn diagnosed_at(
+    model: &Model,
+    reference: &[Record],
+    trials: &[Record],
+    seed: u64,
+    effect: &str,
+) -> (super::Diagnosis, Ranked) {
+    let cfg = DiagnoseConfig {
+        seed,
+        ..DiagnoseConfig::default()
+    };
+    let d = diagnose(model, reference, trials, &[], &cfg).unwrap();
+    let row = d
+        .ranking
+        .iter()
+        .find(|r| r.effect == effect)
+        .unwrap()
+        .clone();
+    println!("{} {row:?}\n{}", d.verdict, d.explanation);
+    (d, row)
+}
+
 #[test]
 fn zig_zag_trials_against_a_prbs_reference_are_judged_with_the_hulls_own_physics() {
     // KVLCC2 at full scale, effect-free ±20° zig-zags against its PRBS reference: at the
@@ -271,13 +295,7 @@ fn zig_zags_that_each_hold_one_course_are_not_read_as_a_current_from_the_yaw_cha
     let (model, reference, trials) = zig_zags_against_prbs(crate::sim::WorldKind::Lng, 1);
     let sep = super::super::separation::heading_separation(&trials).unwrap();
     assert!(sep < 0.005, "{sep}");
-    let cfg = DiagnoseConfig {
-        seed: 1,
-        ..DiagnoseConfig::default()
-    };
-    let d = diagnose(&model, &reference, &trials, &[], &cfg).unwrap();
-    let current = d.ranking.iter().find(|r| r.effect == "current").unwrap();
-    println!("{} {current:?}\n{}", d.verdict, d.explanation);
+    let (d, current) = diagnosed_at(&model, &reference, &trials, 1, "current");
     assert_ne!(d.verdict, "current", "{}", d.explanation);
     assert_ne!(d.verdict, "wind", "{}", d.explanation);
     // the yaw channel's statistic is as large as before, and not counted
@@ -295,22 +313,13 @@ fn without_an_anemometer_records_that_each_hold_one_course_show_no_wind() {
     // channel is the speed over ground's heading harmonics, which the speed lost in the
     // turns of one course shows as well. The second harmonic read `wind` at p = 2.5e-5; the
     // records cannot tell a wind, and nothing is named from them
-    let (model, reference, mut trials) = zig_zags_against_prbs(crate::sim::WorldKind::Lng, 2);
-    for r in reference.iter().chain(&trials) {
-        assert!(r.wind_speed.is_some() && r.cog.is_some(), "{}", r.name);
-    }
-    let mut reference = reference;
+    let (model, mut reference, mut trials) = zig_zags_against_prbs(crate::sim::WorldKind::Lng, 2);
     for r in reference.iter_mut().chain(trials.iter_mut()) {
+        assert!(r.wind_speed.is_some() && r.cog.is_some(), "{}", r.name);
         r.wind_speed = None;
         r.wind_angle = None;
     }
-    let cfg = DiagnoseConfig {
-        seed: 2,
-        ..DiagnoseConfig::default()
-    };
-    let d = diagnose(&model, &reference, &trials, &[], &cfg).unwrap();
-    let wind = d.ranking.iter().find(|r| r.effect == "wind").unwrap();
-    println!("{} {wind:?}\n{}", d.verdict, d.explanation);
+    let (d, wind) = diagnosed_at(&model, &reference, &trials, 2, "wind");
     assert_eq!(d.verdict, "none", "{}", d.explanation);
     assert_eq!(wind.p_value, 1.0, "{wind:?}");
     assert!(wind.evidence.contains("wind is not counted"), "{wind:?}");
