@@ -65,11 +65,11 @@ pub enum Caveat {
     },
     /// A current named from speed over ground alone on trials that each hold one course,
     /// with no anemometer: the yaw channel cannot tell a heading-dependent moment from the
-    /// manoeuvre's own ([`super::separation::heading_separation`]), so nothing in the records
-    /// tells a current from a wind.
+    /// manoeuvre's own (docs/method.md, "Records that each hold one course"), so nothing in
+    /// the records tells a current from a wind.
     CurrentOrWind {
         /// The least share of the heading harmonics' variance the trials keep beyond each
-        /// record's own offset and turn (under [`super::separation::MIN_HEADING_SEPARATION`]).
+        /// record's own offset and turn (under 0.005).
         separation: f64,
     },
     /// An angle limit or a dead band named (first or second) on trials whose commands hold
