@@ -227,11 +227,11 @@ pub(super) fn current_or_wind(
     }
     let p_moment = moment_p(&ev[ic], &ev[iw]);
     // without an anemometer the yaw channel decides, where it is counted; on trials that
-    // each hold one course it is not, and nothing tells whether the ship is turned
-    let counted = ev[ic].yaw_counted && ev[iw].yaw_counted;
+    // each hold one course it is not, and nothing decides whether the ship is turned
+    let undecided = anemometer.is_none() && !(ev[ic].yaw_counted && ev[iw].yaw_counted);
     let (p_decide, wind) = match anemometer {
         Some(p) => (p, p < alpha),
-        None => (p_moment, counted && p_moment < alpha),
+        None => (p_moment, !undecided && p_moment < alpha),
     };
     let (witness, turned, carried) = match anemometer {
         Some(_) => (
@@ -246,7 +246,7 @@ pub(super) fn current_or_wind(
              being turned, a current",
         ),
     };
-    let words = if anemometer.is_none() && !counted {
+    let words = if undecided {
         format!(
             "; {witness}: not counted (the trials each hold one course), so the records cannot \
              tell whether the ship is turned, nor a current from a wind: wind is not counted, \
@@ -266,10 +266,10 @@ pub(super) fn current_or_wind(
     ev[ic].speed_only = !wind;
     ev[iw].speed_only = !wind;
     if anemometer.is_none() {
-        let m = if counted {
-            Moment::Tested(p_moment)
-        } else {
+        let m = if undecided {
             Moment::NotCounted
+        } else {
+            Moment::Tested(p_moment)
         };
         ev[ic].moment = Some(m);
         ev[iw].moment = Some(m);
@@ -286,7 +286,7 @@ pub(super) fn current_or_wind(
         let w = &mut ev[iw];
         w.p = w.p.max(p_decide);
         w.channel_material = false;
-    } else if !counted {
+    } else if undecided {
         // nothing shows a wind: what sets wind apart from a current is the yaw moment (not
         // counted here) or the anemometer (not logged); its remaining evidence, the speed
         // over ground's heading harmonics, a current or the speed lost in the turns of one
