@@ -23,6 +23,7 @@ pub use checks::{
     check_uniform, unit_warnings, unwrap_degrees, validate_record, Limits, MIN_COMMAND_SPAN_DEG,
     MIN_RATE_SPAN_DEGPS,
 };
+pub(crate) use csv_file::Dialect;
 pub use csv_file::{csv_text, parse_csv, read_csv, read_csv_with, resample, write_csv, Columns};
 pub use heading::{block_mean, heading_bias, HeadingBias};
 

@@ -292,13 +292,8 @@ pub fn parse_nav_csv(
     samples: usize,
     ts: f64,
 ) -> Result<Option<Nav>, NavError> {
-    let first = text.lines().find(|l| !l.trim_start().starts_with('#'));
-    let semicolons = first.is_some_and(|l| l.contains(';') && !l.contains(','));
-    let mut rdr = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .comment(Some(b'#'))
-        .delimiter(if semicolons { b';' } else { b',' })
-        .from_reader(text.as_bytes());
+    let dialect = crate::io::data::Dialect::of(text);
+    let mut rdr = dialect.reader(text);
     let csv_err = |e: csv::Error| NavError::Csv {
         path: path.to_path_buf(),
         message: e.to_string(),
@@ -357,12 +352,7 @@ pub fn parse_nav_csv(
             if s.is_empty() {
                 return Ok(f64::NAN);
             }
-            let parsed = if semicolons {
-                s.replace(',', ".").parse::<f64>()
-            } else {
-                s.parse::<f64>()
-            };
-            match parsed {
+            match dialect.number(s) {
                 Ok(v) if !v.is_infinite() => Ok(v),
                 _ => Err(NavError::BadCell {
                     path: path.to_path_buf(),

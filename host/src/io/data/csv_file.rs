@@ -95,12 +95,8 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
         path: path.to_path_buf(),
         message: e.to_string(),
     };
-    let semicolons = semicolon_separated(text);
-    let mut rdr = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .comment(Some(b'#'))
-        .delimiter(if semicolons { b';' } else { b',' })
-        .from_reader(text.as_bytes());
+    let dialect = Dialect::of(text);
+    let mut rdr = dialect.reader(text);
     let headers: Vec<String> = rdr
         .headers()
         .map_err(csv_err)?
@@ -147,13 +143,7 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
         let rown = i + 1;
         let cell = |idx: usize| -> Result<f64, DataError> {
             let s = row.get(idx).unwrap_or("");
-            // A `;`-separated file writes decimals with a comma (`1,5`).
-            let parsed = if semicolons {
-                s.replace(',', ".").parse::<f64>()
-            } else {
-                s.parse::<f64>()
-            };
-            match parsed {
+            match dialect.number(s) {
                 Ok(v) if v.is_finite() => Ok(v),
                 _ => Err(DataError::BadCell {
                     path: path.to_path_buf(),
@@ -321,15 +311,59 @@ fn course(c: &[f64], at: &[(usize, f64)]) -> Vec<f64> {
         .collect()
 }
 
-/// Whether the CSV text is `;`-separated (the spreadsheet export of locales with a decimal
-/// comma): its header has a `;` and no `,`.
-pub(super) fn semicolon_separated(text: &str) -> bool {
-    let header = text
-        .lines()
-        .map(str::trim)
-        .find(|l| !l.is_empty() && !l.starts_with('#'))
-        .unwrap_or("");
-    header.contains(';') && !header.contains(',')
+/// How a CSV text separates its fields, read from its header (the first line that is not
+/// empty or a `#` comment): `,` as written by yawcast; `;` where the header has a `;` and
+/// no `,` (the spreadsheet export of locales with a decimal comma); a tab where the header
+/// has a tab and neither (a logger's or spreadsheet's tab-separated text). In `;`- and
+/// tab-separated text a cell's decimal comma is read as a point (`1,5` is 1.5).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Dialect {
+    /// The field separator.
+    pub(crate) delimiter: u8,
+    /// Whether a cell's `,` is its decimal point.
+    pub(crate) decimal_comma: bool,
+}
+
+impl Dialect {
+    /// The dialect of `text` (type docs).
+    pub(crate) fn of(text: &str) -> Dialect {
+        let header = text
+            .lines()
+            .map(str::trim)
+            .find(|l| !l.is_empty() && !l.starts_with('#'))
+            .unwrap_or("");
+        let delimiter = if header.contains(',') {
+            b','
+        } else if header.contains(';') {
+            b';'
+        } else if header.contains('\t') {
+            b'\t'
+        } else {
+            b','
+        };
+        Dialect {
+            delimiter,
+            decimal_comma: delimiter != b',',
+        }
+    }
+
+    /// A reader of `text` in this dialect: fields trimmed, `#` lines skipped.
+    pub(crate) fn reader<'a>(&self, text: &'a str) -> csv::Reader<&'a [u8]> {
+        csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .comment(Some(b'#'))
+            .delimiter(self.delimiter)
+            .from_reader(text.as_bytes())
+    }
+
+    /// `cell` as a number, its decimal comma read as a point where the dialect has one.
+    pub(crate) fn number(&self, cell: &str) -> Result<f64, std::num::ParseFloatError> {
+        if self.decimal_comma {
+            cell.replace(',', ".").parse::<f64>()
+        } else {
+            cell.parse::<f64>()
+        }
+    }
 }
 
 /// Writes a record as a measurement CSV ([`csv_text`]), atomically (temp file, then rename).

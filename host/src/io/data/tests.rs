@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use super::csv_file::semicolon_separated;
+use super::csv_file::Dialect;
 use super::*;
 
 fn parse(txt: &str) -> Result<Record, DataError> {
@@ -354,7 +354,33 @@ fn semicolon_files_with_decimal_commas_are_read() {
     assert_eq!(r.u, vec![1.5, -2.0, 3.0]);
     assert_eq!(r.y, vec![0.0, 0.25, -0.125]);
     // A comma file whose cells hold `;` stays a comma file (and fails on the cell).
-    assert!(!semicolon_separated("t_s,delta_deg;x,r_degps\n"));
+    assert_eq!(Dialect::of("t_s,delta_deg;x,r_degps\n").delimiter, b',');
+    // the header decides, after blank and comment lines
+    assert_eq!(
+        Dialect::of("\n# logger v2\nt_s;delta_deg\n").delimiter,
+        b';'
+    );
+}
+
+#[test]
+fn tab_separated_files_are_read_with_either_decimal_mark() {
+    let r = parse("t_s\tdelta_deg\tr_degps\n0\t1.5\t0\n0.5\t-2\t0,25\n1\t3\t-0.125\n").unwrap();
+    assert_eq!(r.ts, 0.5);
+    assert_eq!(r.u, vec![1.5, -2.0, 3.0]);
+    assert_eq!(r.y, vec![0.0, 0.25, -0.125]);
+    assert_eq!(
+        Dialect::of("t_s\tdelta_deg\n"),
+        Dialect {
+            delimiter: b'\t',
+            decimal_comma: true
+        }
+    );
+    // a bad cell is still named by its row and column
+    let e = parse("t_s\tdelta_deg\tr_degps\n0\t1\t0\n1\tx\t0\n").unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "f.csv: row 2, column `delta_deg`: expected a finite number, found `x`"
+    );
 }
 
 #[test]
