@@ -14,6 +14,7 @@ mod csv_file;
 mod heading;
 #[cfg(test)]
 mod tests;
+mod timestamp;
 
 pub use atomic::{
     check_outputs, write_all_atomic, write_all_atomic_with, write_atomic, AtomicWriter,
@@ -26,6 +27,7 @@ pub use checks::{
 pub(crate) use csv_file::Dialect;
 pub use csv_file::{csv_text, parse_csv, read_csv, read_csv_with, resample, write_csv, Columns};
 pub use heading::{block_mean, heading_bias, HeadingBias};
+pub(crate) use timestamp::days_from_civil;
 
 /// Relative distance within which the fitted sample period is snapped to a value with at
 /// most three significant digits (timestamp jitter leaves the fit a hair off the logger's
@@ -116,6 +118,21 @@ pub enum DataError {
         expected: f64,
         /// What the step means and what to do about it.
         what: String,
+    },
+    /// A time cell is not a date-time where the first row's is (ISO 8601).
+    #[error(
+        "{path}: row {row}, column `{column}`: expected an ISO 8601 date-time like the first \
+         row's (e.g. 2024-05-01T12:00:00.5Z), found `{value}`"
+    )]
+    BadTime {
+        /// File concerned.
+        path: PathBuf,
+        /// 1-based data row (header is row 0).
+        row: usize,
+        /// Column name.
+        column: String,
+        /// Offending text.
+        value: String,
     },
     /// Two columns share a name, so which one is meant cannot be told.
     #[error(

@@ -52,7 +52,7 @@ use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
-use crate::io::data::Record;
+use crate::io::data::{days_from_civil, Record};
 
 mod fields;
 
@@ -595,20 +595,6 @@ fn clock_seconds(t: chrono::NaiveTime, day: Option<i64>) -> f64 {
         Some(d) => d as f64 * 86_400.0 + s,
         None => s,
     }
-}
-
-/// Days since 1970-01-01 of a civil date (proleptic Gregorian), `None` for an invalid date.
-fn days_from_civil(y: i64, m: i64, d: i64) -> Option<i64> {
-    if !(1..=12).contains(&m) || !(1..=31).contains(&d) {
-        return None;
-    }
-    let y = if m <= 2 { y - 1 } else { y };
-    let era = y.div_euclid(400);
-    let yoe = y - era * 400;
-    let mp = (m + 9) % 12;
-    let doy = (153 * mp + 2) / 5 + d - 1;
-    let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
-    Some(era * 146_097 + doe - 719_468)
 }
 
 /// hh:mm:ss.ss of a clock value (seconds, possibly with a day offset).

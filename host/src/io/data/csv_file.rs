@@ -2,6 +2,7 @@
 
 use std::path::Path;
 
+use super::timestamp::{parse_iso8601, Stamp};
 use super::{check_uniform, unwrap_degrees, write_atomic, DataError, Record};
 
 /// Column names of the measurement CSV (overridable for other loggers).
@@ -138,6 +139,7 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
         cog: icog.map(|_| Vec::new()),
         ..Record::default()
     };
+    let mut origin: Option<Stamp> = None;
     for (i, row) in rdr.records().enumerate() {
         let row = row.map_err(csv_err)?;
         let rown = i + 1;
@@ -153,7 +155,28 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
                 }),
             }
         };
-        rec.t.push(cell(it)?);
+        // the time: seconds, or ISO 8601 date-times when the first row holds one (then
+        // seconds from that first stamp)
+        let raw_t = row.get(it).unwrap_or("");
+        let t = match (rown, origin) {
+            (1, _) => match parse_iso8601(raw_t) {
+                Some(stamp) => {
+                    origin = Some(stamp);
+                    0.0
+                }
+                None => cell(it)?,
+            },
+            (_, Some(o)) => parse_iso8601(raw_t)
+                .map(|stamp| stamp.since(&o))
+                .ok_or_else(|| DataError::BadTime {
+                    path: path.to_path_buf(),
+                    row: rown,
+                    column: headers[it].clone(),
+                    value: raw_t.to_string(),
+                })?,
+            (_, None) => cell(it)?,
+        };
+        rec.t.push(t);
         rec.u.push(cell(iu)? * cols.angle_scale);
         rec.y.push(cell(iy)? * cols.rate_scale);
         if let (Some(i), Some(v)) = (ipsi, rec.psi.as_mut()) {

@@ -534,3 +534,28 @@ fn speeds_in_knots_or_km_per_h_are_read_as_m_per_s() {
     assert_eq!((kn.u, kn.y), (mps.u, mps.y));
     assert_eq!(kn.wind_angle, mps.wind_angle);
 }
+
+#[test]
+fn iso_date_times_in_the_time_column_are_seconds_from_the_first() {
+    let txt = "t_s,delta_deg,r_degps\n\
+               2024-05-01T23:59:59.5Z,1,0\n\
+               2024-05-02T00:00:00.0Z,2,0.5\n\
+               2024-05-02T02:00:00.5+02:00,3,0.25\n";
+    let r = parse(txt).unwrap();
+    assert_eq!(r.t, vec![0.0, 0.5, 1.0]);
+    assert_eq!(r.ts, 0.5);
+    assert_eq!(r.u, vec![1.0, 2.0, 3.0]);
+    // one stamp that is not a date-time is named with its row
+    let bad = txt.replace("2024-05-02T00:00:00.0Z", "0.5");
+    let e = parse(&bad).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "f.csv: row 2, column `t_s`: expected an ISO 8601 date-time like the first row's \
+         (e.g. 2024-05-01T12:00:00.5Z), found `0.5`"
+    );
+    // a missing sample is a gap, as with seconds
+    let gap = "t_s,delta_deg,r_degps\n2024-05-01 12:00:00,0,0\n2024-05-01 12:00:01,0,0\n\
+               2024-05-01 12:00:02,0,0\n2024-05-01 12:00:04,0,0\n";
+    let e = parse(gap).unwrap_err();
+    assert!(matches!(&e, DataError::NonUniform { row: 4, .. }), "{e}");
+}
