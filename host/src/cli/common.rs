@@ -148,6 +148,11 @@ pub struct ReadArgs {
     /// interpolated — instead of requiring uniform time stamps.
     #[arg(long, value_name = "SECONDS")]
     pub resample: Option<f64>,
+    /// CSV without a rate gyro: the yaw rate is the heading's change over each sample,
+    /// (ψ_t − ψ_{t−1})/Ts, the first sample taking the second's; a yaw-rate column is not
+    /// read. The controller must form its measurement the same way.
+    #[arg(long)]
+    pub rate_from_heading: bool,
     /// NMEA logs without a ZDA/RMC clock: the rate (Hz) at which ROT sentences arrive.
     #[arg(long, value_name = "HZ")]
     pub nmea_rate: Option<f64>,
@@ -195,6 +200,7 @@ impl Default for ReadArgs {
             max_gap: None,
             skip_bad_checksums: false,
             resample: None,
+            rate_from_heading: false,
             max_angle: Limits::default().angle_deg,
             max_rate: Limits::default().rate_degps,
             max_speed: Limits::default().speed_mps,
@@ -225,6 +231,7 @@ impl ReadArgs {
             },
             speed_scale: self.speed_unit.to_mps(),
             resample: self.resample,
+            rate_from_heading: self.rate_from_heading,
         }
     }
 
@@ -258,6 +265,27 @@ impl ReadArgs {
         }
     }
 
+    /// Whether `path` (its text `text`) is read as NMEA: `--format`, else by its name —
+    /// `.nmea` and `.nmea0183` are NMEA, `.csv` and `.tsv` tables — and for a logger's
+    /// `.log` or `.txt` by its text (NMEA sentences start with `$`, which no table holds);
+    /// any other name by whether its first line is a sentence.
+    fn is_nmea(&self, path: &Path, text: &str) -> bool {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        match self.format {
+            Format::Nmea => true,
+            Format::Csv => false,
+            Format::Auto => match ext.as_str() {
+                "nmea" | "nmea0183" => true,
+                "csv" | "tsv" => false,
+                "log" | "txt" => text.contains('$'),
+                _ => nmea::looks_like_nmea(text),
+            },
+        }
+    }
+
     /// Reads one record file (CSV or NMEA).
     ///
     /// Errors name the file, row/line and column/sentence; they count as bad input.
@@ -278,18 +306,14 @@ impl ReadArgs {
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        let ext = path
-            .extension()
-            .map(|e| e.to_string_lossy().to_ascii_lowercase())
-            .unwrap_or_default();
-        let is_nmea = match self.format {
-            Format::Nmea => true,
-            Format::Csv => false,
-            Format::Auto => {
-                matches!(ext.as_str(), "nmea" | "log" | "txt" | "nmea0183")
-                    || (ext != "csv" && nmea::looks_like_nmea(&text))
-            }
-        };
+        let is_nmea = self.is_nmea(path, &text);
+        if is_nmea && self.rate_from_heading {
+            return Err(bad(format!(
+                "{}: --rate-from-heading reads CSV records; an NMEA log gives the rate of turn \
+                 in its ROT sentences",
+                path.display()
+            )));
+        }
         let (rec, cols) = if is_nmea {
             let rec = nmea::parse_nmea(&text, path, &name, &self.nmea())?;
             let cols = Columns {
@@ -331,18 +355,7 @@ impl ReadArgs {
         let bytes = std::fs::read(path)
             .map_err(|e| bad(format!("{}: cannot read: {e}", path.display())))?;
         let text = String::from_utf8_lossy(&bytes);
-        let ext = path
-            .extension()
-            .map(|e| e.to_string_lossy().to_ascii_lowercase())
-            .unwrap_or_default();
-        let is_nmea = match self.format {
-            Format::Nmea => true,
-            Format::Csv => false,
-            Format::Auto => {
-                matches!(ext.as_str(), "nmea" | "log" | "txt" | "nmea0183")
-                    || (ext != "csv" && nmea::looks_like_nmea(&text))
-            }
-        };
+        let is_nmea = self.is_nmea(path, &text);
         if is_nmea {
             let nn = nmea::parse_nmea_nav(&text, path, &self.nmea(), rec)
                 .map_err(|e| bad(e.to_string()))?;

@@ -25,7 +25,9 @@ pub use checks::{
     MIN_RATE_SPAN_DEGPS,
 };
 pub(crate) use csv_file::Dialect;
-pub use csv_file::{csv_text, parse_csv, read_csv, read_csv_with, resample, write_csv, Columns};
+pub use csv_file::{
+    csv_text, heading_rate, parse_csv, read_csv, read_csv_with, resample, write_csv, Columns,
+};
 pub use heading::{block_mean, heading_bias, HeadingBias};
 pub(crate) use timestamp::days_from_civil;
 
@@ -118,6 +120,21 @@ pub enum DataError {
         expected: f64,
         /// What the step means and what to do about it.
         what: String,
+    },
+    /// The yaw-rate column is absent where a heading is logged.
+    #[error(
+        "{path}: missing column `{column}` (found: {found}); the heading `{heading}` is \
+         logged: --rate-from-heading takes the yaw rate as its change over each sample"
+    )]
+    NoRate {
+        /// File concerned.
+        path: PathBuf,
+        /// The yaw-rate column expected.
+        column: String,
+        /// The heading column found.
+        heading: String,
+        /// Columns actually present.
+        found: String,
     },
     /// A time cell is not a date-time where the first row's is (ISO 8601).
     #[error(

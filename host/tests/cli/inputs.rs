@@ -100,10 +100,22 @@ fn custom_columns_and_units() {
             v[2].to_radians()
         ));
     }
+    // and as a logger's tab-separated text with ISO 8601 time stamps (not NMEA: no `$`)
+    let mut tab = String::from("t_s\tdelta_deg\tr_degps\n");
+    for l in deg.lines().skip(1) {
+        let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+        let (min, sec) = ((v[0] / 60.0).floor(), v[0] % 60.0);
+        tab.push_str(&format!(
+            "2024-05-01T12:{min:02}:{sec:04.1}Z\t{}\t{}\n",
+            v[1], v[2]
+        ));
+    }
     std::fs::write(d.join("deg.csv"), deg).unwrap();
     std::fs::write(d.join("rad.csv"), rad).unwrap();
+    std::fs::write(d.join("tab.txt"), tab).unwrap();
     let j1 = d.join("deg.json");
     let j2 = d.join("rad.json");
+    let j3 = d.join("tab.json");
     let compare = |file: &str, extra: &[&str]| {
         let (model, data) = (m.to_str().unwrap(), d.join(file));
         let mut args = vec![
@@ -135,14 +147,17 @@ fn custom_columns_and_units() {
             j2.to_str().unwrap(),
         ],
     );
+    compare("tab.txt", &["--json", j3.to_str().unwrap()]);
     // the speed unit is an option of every reading command (knots, km/h, m/s)
     compare("deg.csv", &["--speed-unit", "kn"]);
     let a: serde_json::Value = serde_json::from_slice(&std::fs::read(j1).unwrap()).unwrap();
     let b: serde_json::Value = serde_json::from_slice(&std::fs::read(j2).unwrap()).unwrap();
+    let c: serde_json::Value = serde_json::from_slice(&std::fs::read(j3).unwrap()).unwrap();
     for h in ["1", "5", "10", "20", "sim"] {
         let fa = a["mean_fit"][h].as_f64().unwrap();
         let fb = b["mean_fit"][h].as_f64().unwrap();
         assert!((fa - fb).abs() < 1e-6, "{h}: {fa} vs {fb}");
+        assert_eq!(c["mean_fit"][h], a["mean_fit"][h], "{h}");
     }
     // Pinned field names of the compare summary.
     assert_eq!(a["command"], "compare");

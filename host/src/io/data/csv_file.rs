@@ -33,6 +33,9 @@ pub struct Columns {
     pub speed_scale: f64,
     /// Resample onto a uniform grid of this step (s) instead of requiring uniform time stamps.
     pub resample: Option<f64>,
+    /// No rate gyro: the yaw rate is the heading's change over each sample
+    /// ([`heading_rate`]), and the yaw-rate column is not read.
+    pub rate_from_heading: bool,
 }
 
 impl Default for Columns {
@@ -50,6 +53,7 @@ impl Default for Columns {
             rate_scale: 1.0,
             speed_scale: 1.0,
             resample: None,
+            rate_from_heading: false,
         }
     }
 }
@@ -124,8 +128,25 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
     };
     let it = need(&cols.t)?;
     let iu = need(&cols.u)?;
-    let iy = need(&cols.y)?;
     let ipsi = find(&cols.psi);
+    let iy = if cols.rate_from_heading {
+        // the rate is the heading's change (below); a rate column is not read
+        need(&cols.psi)?;
+        None
+    } else {
+        match (find(&cols.y), ipsi) {
+            (Some(i), _) => Some(i),
+            (None, Some(_)) => {
+                return Err(DataError::NoRate {
+                    path: path.to_path_buf(),
+                    column: cols.y.clone(),
+                    heading: cols.psi.clone(),
+                    found: headers.join(","),
+                })
+            }
+            (None, None) => Some(need(&cols.y)?),
+        }
+    };
     let isp = find(&cols.speed);
     let iws = find(&cols.wind_speed);
     let iwa = find(&cols.wind_angle);
@@ -178,7 +199,10 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
         };
         rec.t.push(t);
         rec.u.push(cell(iu)? * cols.angle_scale);
-        rec.y.push(cell(iy)? * cols.rate_scale);
+        rec.y.push(match iy {
+            Some(i) => cell(i)? * cols.rate_scale,
+            None => 0.0,
+        });
         if let (Some(i), Some(v)) = (ipsi, rec.psi.as_mut()) {
             v.push(cell(i)? * cols.angle_scale);
         }
@@ -222,13 +246,37 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
     if let Some(psi) = rec.psi.as_mut() {
         unwrap_degrees(psi);
     }
-    match cols.resample {
-        Some(dt) => resample(&rec, dt, path),
+    let mut rec = match cols.resample {
+        Some(dt) => resample(&rec, dt, path)?,
         None => {
             rec.ts = check_uniform(&rec.t, path)?;
-            Ok(rec)
+            rec
+        }
+    };
+    if cols.rate_from_heading {
+        if let Some(psi) = rec.psi.as_ref() {
+            rec.y = heading_rate(psi, rec.ts);
         }
     }
+    Ok(rec)
+}
+
+/// The yaw rate a controller without a rate gyro forms from its (unwrapped) heading: the
+/// change over each sample, `(ψ_t − ψ_{t−1})/Ts` (deg/s), the first sample taking the
+/// second's — causal, so the controller can form the same measurement as it sails.
+///
+/// ```
+/// let r = yawcast::io::data::heading_rate(&[10.0, 10.5, 11.5, 11.5], 0.5);
+/// assert_eq!(r, vec![1.0, 1.0, 2.0, 0.0]);
+/// ```
+pub fn heading_rate(psi: &[f64], ts: f64) -> Vec<f64> {
+    let mut r: Vec<f64> = psi.windows(2).map(|w| (w[1] - w[0]) / ts).collect();
+    if let Some(&first) = r.first() {
+        r.insert(0, first);
+    } else if !psi.is_empty() {
+        r.push(0.0);
+    }
+    r
 }
 
 /// Resamples a record onto the uniform grid `t_0, t_0 + dt, …` within its time span: the

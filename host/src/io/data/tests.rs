@@ -559,3 +559,47 @@ fn iso_date_times_in_the_time_column_are_seconds_from_the_first() {
     let e = parse(gap).unwrap_err();
     assert!(matches!(&e, DataError::NonUniform { row: 4, .. }), "{e}");
 }
+
+#[test]
+fn without_a_rate_gyro_the_heading_gives_the_rate_when_asked() {
+    let txt = "t_s,delta_deg,psi_deg\n0,1,359.5\n0.5,1,0.0\n1,1,1.0\n1.5,1,1.0\n";
+    let e = parse(txt).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "f.csv: missing column `r_degps` (found: t_s,delta_deg,psi_deg); the heading \
+         `psi_deg` is logged: --rate-from-heading takes the yaw rate as its change over each \
+         sample"
+    );
+    let cols = Columns {
+        rate_from_heading: true,
+        ..Columns::default()
+    };
+    let r = parse_csv(txt, Path::new("f.csv"), "f", &cols).unwrap();
+    // unwrapped through north first: 359.5 → 360 → 361
+    assert_eq!(r.y, vec![1.0, 1.0, 2.0, 0.0]);
+    assert_eq!(r.ts, 0.5);
+    // a logged rate column is not read then
+    let both = "t_s,delta_deg,r_degps,psi_deg\n0,1,9,10\n1,1,9,11\n2,1,9,13\n";
+    let r = parse_csv(both, Path::new("f.csv"), "f", &cols).unwrap();
+    assert_eq!(r.y, vec![1.0, 1.0, 2.0]);
+    // resampled first, then differenced on the grid
+    let jitter = "t_s,delta_deg,psi_deg\n0,0,0\n0.9,0,0.9\n2.1,0,2.1\n3,0,3\n";
+    let r = parse_csv(
+        jitter,
+        Path::new("f.csv"),
+        "f",
+        &Columns {
+            resample: Some(1.0),
+            ..cols.clone()
+        },
+    )
+    .unwrap();
+    assert_eq!(r.y.len(), r.psi.as_ref().unwrap().len());
+    assert!(r.y.iter().all(|v| (v - 1.0).abs() < 1e-9), "{:?}", r.y);
+    // no heading, nothing to take it from
+    let e = parse_csv("t_s,delta_deg\n0,1\n1,1\n", Path::new("f.csv"), "f", &cols).unwrap_err();
+    assert!(
+        matches!(&e, DataError::MissingColumn { column, .. } if column == "psi_deg"),
+        "{e}"
+    );
+}
