@@ -301,7 +301,7 @@ impl ReadArgs {
 
     /// [`ReadArgs::read`] on the bytes of `path` (already read), without the unit warnings.
     pub fn parse(&self, bytes: &[u8], path: &Path) -> Result<Record> {
-        let text = String::from_utf8_lossy(bytes);
+        let text = data::decode_text(bytes);
         let name = path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
@@ -354,7 +354,7 @@ impl ReadArgs {
     pub fn read_nav(&self, path: &Path, rec: &Record) -> Result<Option<Nav>> {
         let bytes = std::fs::read(path)
             .map_err(|e| bad(format!("{}: cannot read: {e}", path.display())))?;
-        let text = String::from_utf8_lossy(&bytes);
+        let text = data::decode_text(&bytes);
         let is_nmea = self.is_nmea(path, &text);
         if is_nmea {
             let nn = nmea::parse_nmea_nav(&text, path, &self.nmea(), rec)

@@ -26,7 +26,8 @@ pub use checks::{
 };
 pub(crate) use csv_file::Dialect;
 pub use csv_file::{
-    csv_text, heading_rate, parse_csv, read_csv, read_csv_with, resample, write_csv, Columns,
+    csv_text, decode_text, heading_rate, parse_csv, read_csv, read_csv_with, resample, write_csv,
+    Columns,
 };
 pub use heading::{block_mean, heading_bias, HeadingBias};
 pub(crate) use timestamp::days_from_civil;

@@ -257,7 +257,7 @@ pub fn read_nmea(path: &Path, opts: &NmeaOptions) -> Result<Record, NmeaError> {
         path: path.to_path_buf(),
         source,
     })?;
-    let text = String::from_utf8_lossy(&bytes);
+    let text = crate::io::data::decode_text(&bytes);
     let name = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())

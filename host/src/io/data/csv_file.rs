@@ -72,10 +72,11 @@ pub fn read_csv(path: &Path) -> Result<Record, DataError> {
 /// # Errors
 /// As [`read_csv`].
 pub fn read_csv_with(path: &Path, cols: &Columns) -> Result<Record, DataError> {
-    let text = std::fs::read_to_string(path).map_err(|source| DataError::Io {
+    let bytes = std::fs::read(path).map_err(|source| DataError::Io {
         path: path.to_path_buf(),
         source,
     })?;
+    let text = decode_text(&bytes);
     let name = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -380,6 +381,23 @@ fn course(c: &[f64], at: &[(usize, f64)]) -> Vec<f64> {
             s.atan2(c).to_degrees().rem_euclid(360.0)
         })
         .collect()
+}
+
+/// A log file's bytes as text: UTF-8 (a byte-order mark dropped), or where they are not
+/// valid UTF-8, Latin-1 — the Windows logger's `delta [°]` written in its own code page
+/// reads as `delta [°]`, not as a replacement character no `--col-*` option can name.
+///
+/// ```
+/// use yawcast::io::data::decode_text;
+/// assert_eq!(decode_text(b"\xef\xbb\xbft_s,d [\xc2\xb0]"), "t_s,d [°]");
+/// assert_eq!(decode_text(b"t_s,d [\xb0]"), "t_s,d [°]");
+/// ```
+pub fn decode_text(bytes: &[u8]) -> std::borrow::Cow<'_, str> {
+    let bytes = bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes);
+    match std::str::from_utf8(bytes) {
+        Ok(s) => std::borrow::Cow::Borrowed(s),
+        Err(_) => std::borrow::Cow::Owned(bytes.iter().map(|&b| char::from(b)).collect()),
+    }
 }
 
 /// How a CSV text separates its fields, read from its header (the first line that is not
