@@ -148,6 +148,11 @@ pub struct ReadArgs {
     /// interpolated — instead of requiring uniform time stamps.
     #[arg(long, value_name = "SECONDS")]
     pub resample: Option<f64>,
+    /// CSV: fill up to N missing samples in a row (empty or NaN cells) of the heading, speed
+    /// and wind channels by linear interpolation (the heading the shorter way round); 0: a
+    /// missing sample is an error naming its row.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub fill_gaps: usize,
     /// CSV without a rate gyro: the yaw rate is the heading's change over each sample,
     /// (ψ_t − ψ_{t−1})/Ts, the first sample taking the second's; a yaw-rate column is not
     /// read. The controller must form its measurement the same way.
@@ -201,6 +206,7 @@ impl Default for ReadArgs {
             skip_bad_checksums: false,
             resample: None,
             rate_from_heading: false,
+            fill_gaps: 0,
             max_angle: Limits::default().angle_deg,
             max_rate: Limits::default().rate_degps,
             max_speed: Limits::default().speed_mps,
@@ -232,6 +238,7 @@ impl ReadArgs {
             speed_scale: self.speed_unit.to_mps(),
             resample: self.resample,
             rate_from_heading: self.rate_from_heading,
+            fill_gaps: self.fill_gaps,
         }
     }
 

@@ -26,8 +26,8 @@ pub use checks::{
 };
 pub(crate) use csv_file::Dialect;
 pub use csv_file::{
-    csv_text, decode_text, heading_rate, parse_csv, read_csv, read_csv_with, resample, write_csv,
-    Columns,
+    csv_text, decode_text, fill_gaps, heading_rate, parse_csv, read_csv, read_csv_with, resample,
+    write_csv, Columns,
 };
 pub use heading::{block_mean, heading_bias, HeadingBias};
 pub(crate) use timestamp::days_from_civil;
@@ -121,6 +121,40 @@ pub enum DataError {
         expected: f64,
         /// What the step means and what to do about it.
         what: String,
+    },
+    /// An optional channel's cell is empty or `NaN` (a dropout) and `--fill-gaps` is off.
+    #[error(
+        "{path}: row {row}, column `{column}`: expected a finite number, found `{value}` (a \
+         dropout? --fill-gaps N interpolates up to N missing samples in a row of the heading, \
+         speed and wind channels)"
+    )]
+    Dropout {
+        /// File concerned.
+        path: PathBuf,
+        /// 1-based data row (header is row 0).
+        row: usize,
+        /// Column name.
+        column: String,
+        /// Offending text.
+        value: String,
+    },
+    /// A run of missing samples longer than `--fill-gaps` allows.
+    #[error(
+        "{path}: row {first}, column `{column}`: {missing} samples missing in a row from \
+         there (--fill-gaps fills up to {limit}); split the record there, or leave the channel \
+         out (its --col-… option naming no column)"
+    )]
+    Gap {
+        /// File concerned.
+        path: PathBuf,
+        /// Column name.
+        column: String,
+        /// 1-based data row of the first missing sample.
+        first: usize,
+        /// How many are missing in a row.
+        missing: usize,
+        /// The most `--fill-gaps` fills.
+        limit: usize,
     },
     /// The yaw-rate column is absent where a heading is logged.
     #[error(

@@ -33,6 +33,10 @@ pub struct Columns {
     pub speed_scale: f64,
     /// Resample onto a uniform grid of this step (s) instead of requiring uniform time stamps.
     pub resample: Option<f64>,
+    /// Fill up to this many missing samples in a row (empty or `NaN` cells) of the heading,
+    /// speed and wind channels by interpolation ([`fill_gaps`]); 0: a missing sample is an
+    /// error.
+    pub fill_gaps: usize,
     /// No rate gyro: the yaw rate is the heading's change over each sample
     /// ([`heading_rate`]), and the yaw-rate column is not read.
     pub rate_from_heading: bool,
@@ -54,6 +58,7 @@ impl Default for Columns {
             speed_scale: 1.0,
             resample: None,
             rate_from_heading: false,
+            fill_gaps: 0,
         }
     }
 }
@@ -177,6 +182,23 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
                 }),
             }
         };
+        // an optional channel's cell: empty or NaN is a dropout, kept as NaN to be filled
+        // below where --fill-gaps allows, else an error that names the option
+        let optional = |idx: usize| -> Result<f64, DataError> {
+            let s = row.get(idx).unwrap_or("");
+            if s.is_empty() || s.eq_ignore_ascii_case("nan") {
+                if cols.fill_gaps > 0 {
+                    return Ok(f64::NAN);
+                }
+                return Err(DataError::Dropout {
+                    path: path.to_path_buf(),
+                    row: rown,
+                    column: headers[idx].clone(),
+                    value: s.to_string(),
+                });
+            }
+            cell(idx)
+        };
         // the time: seconds, or ISO 8601 date-times when the first row holds one (then
         // seconds from that first stamp)
         let raw_t = row.get(it).unwrap_or("");
@@ -205,16 +227,16 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
             None => 0.0,
         });
         if let (Some(i), Some(v)) = (ipsi, rec.psi.as_mut()) {
-            v.push(cell(i)? * cols.angle_scale);
+            v.push(optional(i)? * cols.angle_scale);
         }
         if let (Some(i), Some(v)) = (isp, rec.speed.as_mut()) {
-            v.push(cell(i)? * cols.speed_scale);
+            v.push(optional(i)? * cols.speed_scale);
         }
         if let (Some(i), Some(v)) = (iws, rec.wind_speed.as_mut()) {
-            v.push(cell(i)? * cols.speed_scale);
+            v.push(optional(i)? * cols.speed_scale);
         }
         if let (Some(i), Some(v)) = (iwa, rec.wind_angle.as_mut()) {
-            v.push(cell(i)? * cols.angle_scale);
+            v.push(optional(i)? * cols.angle_scale);
         }
         if let (Some(i), Some(v)) = (icog, rec.cog.as_mut()) {
             // a GPS drop-out leaves the course empty (or NaN): missing, not an error
@@ -244,6 +266,24 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
             needed: 2,
         });
     }
+    if cols.fill_gaps > 0 {
+        for (v, column, angle) in [
+            (rec.psi.as_mut(), &cols.psi, true),
+            (rec.speed.as_mut(), &cols.speed, false),
+            (rec.wind_speed.as_mut(), &cols.wind_speed, false),
+            (rec.wind_angle.as_mut(), &cols.wind_angle, true),
+        ] {
+            if let Some(v) = v {
+                fill_gaps(v, cols.fill_gaps, angle).map_err(|(first, missing)| DataError::Gap {
+                    path: path.to_path_buf(),
+                    column: column.clone(),
+                    first: first + 1,
+                    missing,
+                    limit: cols.fill_gaps,
+                })?;
+            }
+        }
+    }
     if let Some(psi) = rec.psi.as_mut() {
         unwrap_degrees(psi);
     }
@@ -260,6 +300,56 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
         }
     }
     Ok(rec)
+}
+
+/// Fills the NaN samples of `v` (dropouts) by linear interpolation between their
+/// neighbours — for an angle (deg) along the shorter way round — and holds the nearest
+/// value before the first or after the last sample logged. A run of more than `limit`
+/// NaN, or a channel with no value at all, is `Err((first index, run length))`.
+///
+/// ```
+/// let mut v = vec![f64::NAN, 1.0, f64::NAN, f64::NAN, 4.0];
+/// yawcast::io::data::fill_gaps(&mut v, 2, false).unwrap();
+/// assert_eq!(v, vec![1.0, 1.0, 2.0, 3.0, 4.0]);
+/// let mut a = vec![358.0, f64::NAN, 2.0];
+/// yawcast::io::data::fill_gaps(&mut a, 1, true).unwrap();
+/// assert_eq!(a[1], 360.0);
+/// let mut long = vec![0.0, f64::NAN, f64::NAN, f64::NAN, 1.0];
+/// assert_eq!(yawcast::io::data::fill_gaps(&mut long, 2, false), Err((1, 3)));
+/// ```
+///
+/// # Errors
+/// The first run of NaN longer than `limit`.
+pub fn fill_gaps(v: &mut [f64], limit: usize, angle: bool) -> Result<(), (usize, usize)> {
+    let mut i = 0;
+    while i < v.len() {
+        if !v[i].is_nan() {
+            i += 1;
+            continue;
+        }
+        let end = (i..v.len()).find(|&j| !v[j].is_nan()).unwrap_or(v.len());
+        if end - i > limit {
+            return Err((i, end - i));
+        }
+        match (i.checked_sub(1).map(|k| v[k]), v.get(end).copied()) {
+            (Some(a), Some(b)) => {
+                let d = if angle {
+                    (b - a + 180.0).rem_euclid(360.0) - 180.0
+                } else {
+                    b - a
+                };
+                let n = (end - i + 1) as f64;
+                for (k, x) in v[i..end].iter_mut().enumerate() {
+                    *x = a + d * (k + 1) as f64 / n;
+                }
+            }
+            (Some(a), None) => v[i..end].fill(a),
+            (None, Some(b)) => v[i..end].fill(b),
+            (None, None) => return Err((i, end - i)),
+        }
+        i = end;
+    }
+    Ok(())
 }
 
 /// The yaw rate a controller without a rate gyro forms from its (unwrapped) heading: the

@@ -603,3 +603,39 @@ fn without_a_rate_gyro_the_heading_gives_the_rate_when_asked() {
         "{e}"
     );
 }
+
+#[test]
+fn dropouts_in_the_optional_channels_are_named_or_filled() {
+    let txt = "t_s,delta_deg,r_degps,psi_deg,u_mps\n\
+               0,1,0,359,5\n1,1,0,,5\n2,1,0,NaN,\n3,1,0,2,6\n4,1,0,3,6\n";
+    let e = parse(txt).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "f.csv: row 2, column `psi_deg`: expected a finite number, found `` (a dropout? \
+         --fill-gaps N interpolates up to N missing samples in a row of the heading, speed \
+         and wind channels)"
+    );
+    let fill = |n| Columns {
+        fill_gaps: n,
+        ..Columns::default()
+    };
+    let r = parse_csv(txt, Path::new("f.csv"), "f", &fill(2)).unwrap();
+    // the heading the shorter way round, then unwrapped: 359 → 360 → 361 → 362
+    assert_eq!(r.psi.unwrap(), vec![359.0, 360.0, 361.0, 362.0, 363.0]);
+    assert_eq!(r.speed.unwrap(), vec![5.0, 5.0, 5.5, 6.0, 6.0]);
+    // a longer run than allowed is named where it starts
+    let e = parse_csv(txt, Path::new("f.csv"), "f", &fill(1)).unwrap_err();
+    assert!(
+        matches!(&e, DataError::Gap { first: 2, missing: 2, limit: 1, column, .. } if column == "psi_deg"),
+        "{e}"
+    );
+    // the command and the yaw rate are never filled
+    let e = parse_csv(
+        "t_s,delta_deg,r_degps\n0,1,0\n1,,0\n",
+        Path::new("f.csv"),
+        "f",
+        &fill(5),
+    )
+    .unwrap_err();
+    assert!(matches!(&e, DataError::BadCell { row: 2, .. }), "{e}");
+}
