@@ -78,10 +78,33 @@ impl SpeedUnit {
     }
 }
 
+/// Unit of the CSV time column (when it holds numbers, not date-times).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum TimeUnit {
+    /// Seconds.
+    S,
+    /// Milliseconds.
+    Ms,
+    /// Microseconds.
+    Us,
+}
+
+impl TimeUnit {
+    /// What a value in this unit is multiplied by to give seconds.
+    fn to_s(self) -> f64 {
+        match self {
+            TimeUnit::S => 1.0,
+            TimeUnit::Ms => 1e-3,
+            TimeUnit::Us => 1e-6,
+        }
+    }
+}
+
 /// File format of a record.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum Format {
-    /// By extension (`.nmea`, `.log`, `.txt` → NMEA) and content (a `$` sentence first).
+    /// By extension (`.nmea` → NMEA; `.csv`, `.tsv` → CSV; `.log`, `.txt` → NMEA when they
+    /// hold a `$` sentence) and otherwise content (a `$` sentence first).
     Auto,
     /// Measurement CSV.
     Csv,
@@ -135,6 +158,9 @@ pub struct ReadArgs {
     /// CSV column holding the position east of an origin in metres (optional; with --col-north).
     #[arg(long, value_name = "NAME", default_value = "east_m")]
     pub col_east: String,
+    /// Unit of the CSV time column when it holds numbers (not ISO 8601 date-times).
+    #[arg(long, value_enum, default_value = "s")]
+    pub time_unit: TimeUnit,
     /// Unit of the CSV angle columns (angle, heading, wind angle).
     #[arg(long, value_enum, default_value = "deg")]
     pub angle_unit: AngleUnit,
@@ -197,6 +223,7 @@ impl Default for ReadArgs {
             col_lon: "lon_deg".into(),
             col_north: "north_m".into(),
             col_east: "east_m".into(),
+            time_unit: TimeUnit::S,
             angle_unit: AngleUnit::Deg,
             rate_unit: RateUnit::Degps,
             speed_unit: SpeedUnit::Mps,
@@ -236,6 +263,7 @@ impl ReadArgs {
                 RateUnit::Radps => rad,
             },
             speed_scale: self.speed_unit.to_mps(),
+            time_scale: self.time_unit.to_s(),
             resample: self.resample,
             rate_from_heading: self.rate_from_heading,
             fill_gaps: self.fill_gaps,

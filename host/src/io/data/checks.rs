@@ -178,7 +178,7 @@ pub fn unit_warnings(rec: &Record) -> Vec<String> {
     let mut out = Vec::new();
     if rec.ts > 60.0 {
         out.push(format!(
-            "the sample time is {} s: if the time column is in milliseconds, divide it by 1000",
+            "the sample time is {} s: if the time column is in milliseconds, give --time-unit ms",
             rec.ts
         ));
     }

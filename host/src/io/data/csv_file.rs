@@ -31,6 +31,9 @@ pub struct Columns {
     pub rate_scale: f64,
     /// Multiply the speed columns (`speed`, `wind_speed`) by this to get m/s.
     pub speed_scale: f64,
+    /// Multiply a numeric time column by this to get seconds (1e-3 for milliseconds; not
+    /// applied to ISO 8601 date-times).
+    pub time_scale: f64,
     /// Resample onto a uniform grid of this step (s) instead of requiring uniform time stamps.
     pub resample: Option<f64>,
     /// Fill up to this many missing samples in a row (empty or `NaN` cells) of the heading,
@@ -56,6 +59,7 @@ impl Default for Columns {
             angle_scale: 1.0,
             rate_scale: 1.0,
             speed_scale: 1.0,
+            time_scale: 1.0,
             resample: None,
             rate_from_heading: false,
             fill_gaps: 0,
@@ -208,7 +212,7 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
                     origin = Some(stamp);
                     0.0
                 }
-                None => cell(it)?,
+                None => cell(it)? * cols.time_scale,
             },
             (_, Some(o)) => parse_iso8601(raw_t)
                 .map(|stamp| stamp.since(&o))
@@ -218,7 +222,7 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
                     column: headers[it].clone(),
                     value: raw_t.to_string(),
                 })?,
-            (_, None) => cell(it)?,
+            (_, None) => cell(it)? * cols.time_scale,
         };
         rec.t.push(t);
         rec.u.push(cell(iu)? * cols.angle_scale);

@@ -553,6 +553,18 @@ fn iso_date_times_in_the_time_column_are_seconds_from_the_first() {
         "f.csv: row 2, column `t_s`: expected an ISO 8601 date-time like the first row's \
          (e.g. 2024-05-01T12:00:00.5Z), found `0.5`"
     );
+    // numeric stamps in milliseconds, scaled; date-times are not
+    let ms = parse_csv(
+        "t_s,delta_deg,r_degps\n1000,0,0\n1500,0,0\n2000,0,0\n",
+        Path::new("f.csv"),
+        "f",
+        &Columns {
+            time_scale: 1e-3,
+            ..Columns::default()
+        },
+    )
+    .unwrap();
+    assert_eq!((ms.t.clone(), ms.ts), (vec![1.0, 1.5, 2.0], 0.5));
     // a missing sample is a gap, as with seconds
     let gap = "t_s,delta_deg,r_degps\n2024-05-01 12:00:00,0,0\n2024-05-01 12:00:01,0,0\n\
                2024-05-01 12:00:02,0,0\n2024-05-01 12:00:04,0,0\n";
