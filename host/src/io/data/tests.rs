@@ -553,7 +553,7 @@ fn iso_date_times_in_the_time_column_are_seconds_from_the_first() {
         "f.csv: row 2, column `t_s`: expected an ISO 8601 date-time like the first row's \
          (e.g. 2024-05-01T12:00:00.5Z), found `0.5`"
     );
-    // numeric stamps in milliseconds, scaled; date-times are not
+    // numeric stamps in milliseconds, scaled to seconds
     let ms = parse_csv(
         "t_s,delta_deg,r_degps\n1000,0,0\n1500,0,0\n2000,0,0\n",
         Path::new("f.csv"),
