@@ -119,7 +119,8 @@ pub struct ReadArgs {
     /// File format of --data/--validate/--reference files.
     #[arg(long, value_enum, default_value = "auto")]
     pub format: Format,
-    /// CSV column holding time: seconds, or ISO 8601 date-times (2024-05-01T12:00:00.5Z).
+    /// CSV column holding time: seconds, ISO 8601 date-times (2024-05-01T12:00:00.5Z) or
+    /// times of day (12:00:00.5).
     #[arg(long, value_name = "NAME", default_value = "t_s")]
     pub col_time: String,
     /// CSV column holding the commanded pod/rudder angle.

@@ -171,10 +171,11 @@ pub enum DataError {
         /// Columns actually present.
         found: String,
     },
-    /// A time cell is not a date-time where the first row's is (ISO 8601).
+    /// A time cell is not a date-time (ISO 8601) or time of day where the first row's is.
     #[error(
-        "{path}: row {row}, column `{column}`: expected an ISO 8601 date-time like the first \
-         row's (e.g. 2024-05-01T12:00:00.5Z), found `{value}`"
+        "{path}: row {row}, column `{column}`: expected a time stamp like the first row's \
+         (an ISO 8601 date-time such as 2024-05-01T12:00:00.5Z, or a time of day such as \
+         12:00:00.5), found `{value}`"
     )]
     BadTime {
         /// File concerned.

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use super::timestamp::{parse_iso8601, Stamp};
+use super::timestamp::{parse_clock, parse_iso8601, Stamp};
 use super::{check_uniform, unwrap_degrees, write_atomic, DataError, Record};
 
 /// Column names of the measurement CSV (overridable for other loggers).
@@ -93,6 +93,15 @@ pub fn read_csv_with(path: &Path, cols: &Columns) -> Result<Record, DataError> {
     parse_csv(&text, path, &name, cols)
 }
 
+/// What the time column holds, decided by its first row: seconds, ISO 8601 date-times
+/// (from the first stamp), or times of day alone (from the first, with the midnights
+/// crossed so far).
+enum Clock {
+    Seconds,
+    Iso(Stamp),
+    Day(Stamp, i64),
+}
+
 /// Parses CSV text (`path` only labels errors).
 ///
 /// # Errors
@@ -170,7 +179,7 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
         cog: icog.map(|_| Vec::new()),
         ..Record::default()
     };
-    let mut origin: Option<Stamp> = None;
+    let mut clock = Clock::Seconds;
     for (i, row) in rdr.records().enumerate() {
         let row = row.map_err(csv_err)?;
         let rown = i + 1;
@@ -203,26 +212,36 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
             }
             cell(idx)
         };
-        // the time: seconds, or ISO 8601 date-times when the first row holds one (then
-        // seconds from that first stamp)
+        // the time: seconds, or ISO 8601 date-times or times of day when the first row
+        // holds one (then seconds from that first stamp)
         let raw_t = row.get(it).unwrap_or("");
-        let t = match (rown, origin) {
-            (1, _) => match parse_iso8601(raw_t) {
-                Some(stamp) => {
-                    origin = Some(stamp);
-                    0.0
+        if rown == 1 {
+            clock = if let Some(stamp) = parse_iso8601(raw_t) {
+                Clock::Iso(stamp)
+            } else if let Some(stamp) = parse_clock(raw_t) {
+                Clock::Day(stamp, 0)
+            } else {
+                Clock::Seconds
+            };
+        }
+        let bad_time = || DataError::BadTime {
+            path: path.to_path_buf(),
+            row: rown,
+            column: headers[it].clone(),
+            value: raw_t.to_string(),
+        };
+        let t = match &mut clock {
+            Clock::Seconds => cell(it)? * cols.time_scale,
+            Clock::Iso(origin) => parse_iso8601(raw_t).ok_or_else(bad_time)?.since(origin),
+            Clock::Day(origin, days) => {
+                let t = parse_clock(raw_t).ok_or_else(bad_time)?.since(origin);
+                // a time of day that falls back by more than half a day crossed midnight
+                let last = rec.t.last().copied().unwrap_or(0.0);
+                if t + 86_400.0 * (*days as f64) < last - 43_200.0 {
+                    *days += 1;
                 }
-                None => cell(it)? * cols.time_scale,
-            },
-            (_, Some(o)) => parse_iso8601(raw_t)
-                .map(|stamp| stamp.since(&o))
-                .ok_or_else(|| DataError::BadTime {
-                    path: path.to_path_buf(),
-                    row: rown,
-                    column: headers[it].clone(),
-                    value: raw_t.to_string(),
-                })?,
-            (_, None) => cell(it)? * cols.time_scale,
+                t + 86_400.0 * (*days as f64)
+            }
         };
         rec.t.push(t);
         rec.u.push(cell(iu)? * cols.angle_scale);

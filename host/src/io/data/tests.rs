@@ -550,9 +550,17 @@ fn iso_date_times_in_the_time_column_are_seconds_from_the_first() {
     let e = parse(&bad).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "f.csv: row 2, column `t_s`: expected an ISO 8601 date-time like the first row's \
-         (e.g. 2024-05-01T12:00:00.5Z), found `0.5`"
+        "f.csv: row 2, column `t_s`: expected a time stamp like the first row's (an ISO \
+         8601 date-time such as 2024-05-01T12:00:00.5Z, or a time of day such as 12:00:00.5), \
+         found `0.5`"
     );
+    // times of day alone, across midnight
+    let day = parse(
+        "t_s,delta_deg,r_degps\n23:59:59.0,0,0\n23:59:59.5,0,0\n00:00:00.0,0,0\n\
+                     00:00:00.5,0,0\n",
+    )
+    .unwrap();
+    assert_eq!((day.t.clone(), day.ts), (vec![0.0, 0.5, 1.0, 1.5], 0.5));
     // numeric stamps in milliseconds, scaled to seconds
     let ms = parse_csv(
         "t_s,delta_deg,r_degps\n1000,0,0\n1500,0,0\n2000,0,0\n",

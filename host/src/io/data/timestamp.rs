@@ -1,5 +1,6 @@
-//! Time stamps as loggers write them: ISO 8601 date-times (`2024-05-01T12:00:00.25Z`) in the
-//! time column, read as seconds from the record's first stamp.
+//! Time stamps as loggers write them: ISO 8601 date-times (`2024-05-01T12:00:00.25Z`) or a
+//! time of day alone (`23:59:59.5`) in the time column, read as seconds from the record's
+//! first stamp.
 
 /// A date-time read from an ISO 8601 stamp: whole seconds since 1970-01-01 UTC (the stamp's
 /// offset applied; a stamp without one is taken as UTC, so a record's stamps compare with
@@ -69,27 +70,7 @@ pub(crate) fn parse_iso8601(s: &str) -> Option<Stamp> {
         b'T' | b't' | b' ' => &r[1..],
         _ => return None,
     };
-    let (h, r) = digits(r, 2)?;
-    let (mi, mut r) = digits(expect(r, b':')?, 2)?;
-    let mut sec = 0;
-    let mut frac = 0.0;
-    if let Some(rest) = expect(r, b':') {
-        let (ss, rest) = digits(rest, 2)?;
-        sec = ss;
-        r = rest;
-        if let Some(rest) = expect(r, b'.').or_else(|| expect(r, b',')) {
-            let n = rest.bytes().take_while(u8::is_ascii_digit).count();
-            if n == 0 {
-                return None;
-            }
-            frac = format!("0.{}", &rest[..n]).parse().ok()?;
-            r = &rest[n..];
-        }
-    }
-    // 60 admits a leap second, read as the next minute's first
-    if h > 23 || mi > 59 || sec > 60 {
-        return None;
-    }
+    let (clock, r) = time_of_day(r)?;
     let offset = match r.as_bytes().first() {
         None => 0,
         Some(b'Z' | b'z') if r.len() == 1 => 0,
@@ -115,9 +96,52 @@ pub(crate) fn parse_iso8601(s: &str) -> Option<Stamp> {
     };
     let days = days_from_civil(y, mo, d)?;
     Some(Stamp {
-        whole: days * 86_400 + h * 3600 + mi * 60 + sec - offset,
-        frac,
+        whole: days * 86_400 + clock.whole - offset,
+        frac: clock.frac,
     })
+}
+
+/// `hh:mm[:ss[.f…]]` (a decimal comma too) at the start of `s`: the seconds since midnight,
+/// and the rest.
+fn time_of_day(s: &str) -> Option<(Stamp, &str)> {
+    let (h, r) = digits(s, 2)?;
+    let (mi, mut r) = digits(expect(r, b':')?, 2)?;
+    let mut sec = 0;
+    let mut frac = 0.0;
+    if let Some(rest) = expect(r, b':') {
+        let (ss, rest) = digits(rest, 2)?;
+        sec = ss;
+        r = rest;
+        if let Some(rest) = expect(r, b'.').or_else(|| expect(r, b',')) {
+            let n = rest.bytes().take_while(u8::is_ascii_digit).count();
+            if n == 0 {
+                return None;
+            }
+            frac = format!("0.{}", &rest[..n]).parse().ok()?;
+            r = &rest[n..];
+        }
+    }
+    // 60 admits a leap second, read as the next minute's first
+    if h > 23 || mi > 59 || sec > 60 {
+        return None;
+    }
+    Some((
+        Stamp {
+            whole: h * 3600 + mi * 60 + sec,
+            frac,
+        },
+        r,
+    ))
+}
+
+/// A time of day alone, `hh:mm[:ss[.f…]]`, as a logger without a date writes it: seconds
+/// since midnight (the caller counts the midnights a record crosses). `None` for anything
+/// else.
+pub(crate) fn parse_clock(s: &str) -> Option<Stamp> {
+    match time_of_day(s.trim())? {
+        (stamp, "") => Some(stamp),
+        _ => None,
+    }
 }
 
 #[cfg(test)]
@@ -159,6 +183,27 @@ mod tests {
             "",
         ] {
             assert_eq!(parse_iso8601(s), None, "{s}");
+        }
+    }
+
+    #[test]
+    fn a_time_of_day_alone_is_seconds_since_midnight() {
+        assert_eq!(
+            parse_clock("23:59:59.5"),
+            Some(Stamp {
+                whole: 86_399,
+                frac: 0.5
+            })
+        );
+        assert_eq!(parse_clock(" 00:01 ").map(|s| s.whole), Some(60));
+        for s in [
+            "24:00:00",
+            "12:00:00Z",
+            "12.5",
+            "2024-05-01T12:00:00Z",
+            "1:00:00",
+        ] {
+            assert_eq!(parse_clock(s), None, "{s}");
         }
     }
 
