@@ -159,6 +159,16 @@ pub struct ReadArgs {
     /// CSV column holding the position east of an origin in metres (optional; with --col-north).
     #[arg(long, value_name = "NAME", default_value = "east_m")]
     pub col_east: String,
+    /// Multiply the command (CSV column or NMEA RSA) of every record read by this, after
+    /// --angle-unit: -1 for a logger whose positive command turns the ship the other way,
+    /// 0.35 for a rudder logged in per cent of its 35° maximum.
+    #[arg(
+        long,
+        value_name = "K",
+        default_value_t = 1.0,
+        allow_hyphen_values = true
+    )]
+    pub command_scale: f64,
     /// Unit of the CSV time column when it holds numbers (not ISO 8601 date-times).
     #[arg(long, value_enum, default_value = "s")]
     pub time_unit: TimeUnit,
@@ -224,6 +234,7 @@ impl Default for ReadArgs {
             col_lon: "lon_deg".into(),
             col_north: "north_m".into(),
             col_east: "east_m".into(),
+            command_scale: 1.0,
             time_unit: TimeUnit::S,
             angle_unit: AngleUnit::Deg,
             rate_unit: RateUnit::Degps,
@@ -350,7 +361,13 @@ impl ReadArgs {
                 path.display()
             )));
         }
-        let (rec, cols) = if is_nmea {
+        if !(self.command_scale.is_finite() && self.command_scale != 0.0) {
+            return Err(bad(format!(
+                "--command-scale {}: expected a non-zero number",
+                self.command_scale
+            )));
+        }
+        let (mut rec, cols) = if is_nmea {
             let rec = nmea::parse_nmea(&text, path, &name, &self.nmea())?;
             let cols = Columns {
                 u: "RSA rudder angle".into(),
@@ -364,6 +381,9 @@ impl ReadArgs {
             let cols = self.columns();
             (data::parse_csv(&text, path, &name, &cols)?, cols)
         };
+        if self.command_scale != 1.0 {
+            rec.u.iter_mut().for_each(|u| *u *= self.command_scale);
+        }
         data::validate_record(&rec, path, &self.limits()?, &cols)?;
         Ok(rec)
     }

@@ -92,9 +92,10 @@ pub enum InputError {
         "{set} record `{record}`: the model simulates it at {given_pct:.0} % fit with the \
          command as logged and at {negated_pct:.0} % with the command negated, so its command \
          (or its yaw rate) is signed the other way round from the records the model was \
-         identified on; negate its command column, or its yaw-rate column if that is the one \
-         (yawcast needs one sign convention: a positive command turns the ship as it did in \
-         those records, and the yaw rate is positive when the heading grows)"
+         identified on; negate its command column (--command-scale -1 negates every record read), or \
+         its yaw-rate column if that is the one (yawcast needs one sign convention: a positive command \
+         turns the ship as it did in those records, and the yaw rate is positive when the \
+         heading grows)"
     )]
     CommandSign {
         /// The set it belongs to ("trial", "reference", …).

@@ -53,8 +53,8 @@ pub enum MergeError {
     #[error(
         "{set} record `{record}` is signed the other way round from the others: {flipped} of \
          the {of} models identified on the other records simulate it 50 pp or more better \
-         with its command negated; negate its command column (or its yaw-rate column, if that \
-         is the one), so that every record uses one sign convention"
+         with its command negated; negate its command column (--command-scale -1 negates every \
+         record read; or its yaw-rate column, if that is the one), so that every record uses one sign convention"
     )]
     CommandSign {
         /// "estimation" or "validation".

@@ -110,9 +110,17 @@ fn custom_columns_and_units() {
             v[1], v[2]
         ));
     }
-    std::fs::write(d.join("deg.csv"), deg).unwrap();
+    std::fs::write(d.join("deg.csv"), &deg).unwrap();
     std::fs::write(d.join("rad.csv"), rad).unwrap();
     std::fs::write(d.join("tab.txt"), tab).unwrap();
+    // and with the other sign convention, read back with --command-scale -1
+    let mut flipped = String::from("t_s,delta_deg,r_degps\n");
+    for l in deg.lines().skip(1) {
+        let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+        flipped.push_str(&format!("{},{},{}\n", v[0], -v[1], v[2]));
+    }
+    std::fs::write(d.join("flipped.csv"), flipped).unwrap();
+    let j4 = d.join("flipped.json");
     let j1 = d.join("deg.json");
     let j2 = d.join("rad.json");
     let j3 = d.join("tab.json");
@@ -148,16 +156,22 @@ fn custom_columns_and_units() {
         ],
     );
     compare("tab.txt", &["--json", j3.to_str().unwrap()]);
+    compare(
+        "flipped.csv",
+        &["--command-scale", "-1", "--json", j4.to_str().unwrap()],
+    );
     // the speed unit is an option of every reading command (knots, km/h, m/s)
     compare("deg.csv", &["--speed-unit", "kn"]);
     let a: serde_json::Value = serde_json::from_slice(&std::fs::read(j1).unwrap()).unwrap();
     let b: serde_json::Value = serde_json::from_slice(&std::fs::read(j2).unwrap()).unwrap();
     let c: serde_json::Value = serde_json::from_slice(&std::fs::read(j3).unwrap()).unwrap();
+    let f: serde_json::Value = serde_json::from_slice(&std::fs::read(j4).unwrap()).unwrap();
     for h in ["1", "5", "10", "20", "sim"] {
         let fa = a["mean_fit"][h].as_f64().unwrap();
         let fb = b["mean_fit"][h].as_f64().unwrap();
         assert!((fa - fb).abs() < 1e-6, "{h}: {fa} vs {fb}");
         assert_eq!(c["mean_fit"][h], a["mean_fit"][h], "{h}");
+        assert_eq!(f["mean_fit"][h], a["mean_fit"][h], "{h}");
     }
     // Pinned field names of the compare summary.
     assert_eq!(a["command"], "compare");
