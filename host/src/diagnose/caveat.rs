@@ -419,7 +419,7 @@ fn resample_step(sets: [&[Record]; 3]) -> Option<f64> {
 /// current that the yaw channel's heading-dependent moment set apart from wind
 /// ([`super::verdict::current_or_wind`]) and found absent, or could not (`separation`: the
 /// trials' [`super::separation::heading_separation`]).
-pub(super) fn current_or_leeway<'a>(
+pub(super) fn current_without_anemometer<'a>(
     named: impl IntoIterator<Item = &'a Evidence>,
     separation: Option<f64>,
 ) -> Option<Caveat> {

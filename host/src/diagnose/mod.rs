@@ -590,7 +590,7 @@ pub fn diagnose(
         ));
     }
     let verdict_ev = ev.iter().find(|e| e.kind.name() == verdict_name);
-    caveats.extend(caveat::current_or_leeway(
+    caveats.extend(caveat::current_without_anemometer(
         verdict_ev.into_iter().chain(then.as_ref().map(|(e, _)| e)),
         ch.separation,
     ));

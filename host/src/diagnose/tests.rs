@@ -6,7 +6,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use super::caveat::current_or_leeway;
+use super::caveat::current_without_anemometer;
 use super::channels::{sog_evidence, sog_evidence_with, sog_taus};
 use super::evidence::{trial_statistic, Version};
 use super::null::{simulate_innovations, Null};
@@ -605,7 +605,7 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
     assert!((ev[0].p - 8e-4).abs() < 1e-15, "{}", ev[0].p);
     assert!(ev[0].channel_material);
     assert!(ev[0].words.contains("present"), "{}", ev[0].words);
-    assert!(current_or_leeway(&ev, None).is_none());
+    assert!(current_without_anemometer(&ev, None).is_none());
     // the same speed evidence without a yaw moment: a current, wind moved behind it
     let mut ev = vec![
         evidence(EffectKind::Wind, 1e-6, 0.3, true),
@@ -617,19 +617,19 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
     // named from the ground track alone, without an anemometer: a caveat says a wind's
     // leeway would look the same, with the p applied (2 × 0.05); none for the wind, none
     // where an anemometer decided
-    let c = current_or_leeway(&ev, None).unwrap();
+    let c = current_without_anemometer(&ev, None).unwrap();
     assert_eq!(c, Caveat::CurrentOrLeeway { p_moment: 0.1 });
     let json = serde_json::to_value(&c).unwrap();
     assert_eq!(json["caveat"], "current-or-leeway");
     assert!(c.explain().contains("p = 1.0e-1"), "{}", c.explain());
-    assert!(current_or_leeway(&ev[1..], None).is_none());
+    assert!(current_without_anemometer(&ev[1..], None).is_none());
     let mut ev = vec![
         evidence(EffectKind::Current, 1e-7, 0.05, true),
         evidence(EffectKind::Wind, 1e-6, 0.3, true),
     ];
     current_or_wind(&mut ev, level, alpha, true, Some(0.5));
     assert_eq!(kinds(&ev), [EffectKind::Current, EffectKind::Wind]);
-    assert!(current_or_leeway(&ev, None).is_none());
+    assert!(current_without_anemometer(&ev, None).is_none());
     // an anemometer showing no wind outranks a yaw moment varying with heading: the
     // built-in ship's effect-free ±20° zig-zags against its PRBS reference (seed 2) read
     // as wind at p 7.4e-5 from the yaw channel alone, the anemometer's true wind 0.00 m/s
@@ -663,7 +663,7 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
     assert!(ev[0].words.contains("not counted"), "{}", ev[0].words);
     assert!(!ev[0].words.contains("(absent)"), "{}", ev[0].words);
     assert_eq!(ev[0].moment, Some(Moment::NotCounted));
-    let c = current_or_leeway(&ev, Some(0.0012)).unwrap();
+    let c = current_without_anemometer(&ev, Some(0.0012)).unwrap();
     assert_eq!(c, Caveat::CurrentOrWind { separation: 0.0012 });
     let json = serde_json::to_value(&c).unwrap();
     assert_eq!(json["caveat"], "current-or-wind");
@@ -694,7 +694,7 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
         ev[0].words
     );
     assert_eq!(
-        current_or_leeway(&ev, Some(0.0012)),
+        current_without_anemometer(&ev, Some(0.0012)),
         Some(Caveat::CurrentOrLeeway { p_moment: 1.0 })
     );
     // without speed over ground, or with neither significant, nothing changes
