@@ -22,7 +22,7 @@ pub use atomic::{
 };
 pub use checks::{
     check_uniform, unit_warnings, unwrap_degrees, validate_record, Limits, MIN_COMMAND_SPAN_DEG,
-    MIN_RATE_SPAN_DEGPS,
+    MIN_RATE_SPAN_DEGPS, MIN_TURN_DEG,
 };
 pub(crate) use csv_file::Dialect;
 pub use csv_file::{

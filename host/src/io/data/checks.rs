@@ -38,7 +38,9 @@ pub const MIN_RATE_SPAN_DEGPS: f64 = 1e-3;
 ///
 /// # Errors
 /// [`DataError::Implausible`] naming the row and column of the first value beyond a limit,
-/// [`DataError::NoExcitation`] naming the column that never moves.
+/// [`DataError::NoExcitation`] naming the column that never moves, or the heading, course or
+/// speed over ground column that holds one value (a speed: 0) while the yaw rate turns the
+/// ship through [`MIN_TURN_DEG`] or more.
 ///
 /// ```
 /// use yawcast::io::data::{validate_record, Columns, DataError, Limits, Record};
@@ -144,8 +146,52 @@ pub fn validate_record(
         "deg/s",
         "the yaw rate never moves; check that the rate sensor is logged, and its column and \
          unit (--col-rate, --rate-unit)",
-    )
+    )?;
+    // an optional channel a logger fills with a placeholder (a sensor not connected) holds
+    // one value while the yaw rate turns the ship: no heading, course or speed over ground
+    // does that, and every use of the channel would read it as the ship's
+    let mut turned = 0.0f64;
+    let (mut lo, mut hi) = (0.0f64, 0.0f64);
+    for r in &rec.y {
+        turned += r * rec.ts;
+        lo = lo.min(turned);
+        hi = hi.max(turned);
+    }
+    let turn = hi - lo;
+    if turn >= MIN_TURN_DEG {
+        let placeholder = |col: &str, v: Option<&Vec<f64>>, what: &str| {
+            let Some(v) = v else { return Ok(()) };
+            let logged: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+            let (s, value, _) = span(&logged);
+            if logged.len() >= 2 && s == 0.0 {
+                return Err(DataError::NoExcitation {
+                    path: path.to_path_buf(),
+                    column: col.to_string(),
+                    what: format!(
+                        "holds one value ({value}) throughout while the yaw rate turns the ship \
+                         through {turn:.0}°: {what} not logged? Leave the channel out (its \
+                         --col-… option naming no column)"
+                    ),
+                });
+            }
+            Ok(())
+        };
+        placeholder(&cols.psi, rec.psi.as_ref(), "a heading sensor")?;
+        placeholder(&cols.cog, rec.cog.as_ref(), "a course over ground")?;
+        if rec
+            .speed
+            .as_ref()
+            .is_some_and(|v| v.iter().all(|x| *x == 0.0))
+        {
+            placeholder(&cols.speed, rec.speed.as_ref(), "a speed over ground")?;
+        }
+    }
+    Ok(())
 }
+
+/// The turn (deg) the yaw rate integrates to over a record from which a heading, course or
+/// speed over ground that holds one value is refused as a placeholder ([`validate_record`]).
+pub const MIN_TURN_DEG: f64 = 5.0;
 
 /// Warnings about the scale of a record's columns that suggest a unit mix-up: commands that
 /// never leave ±1.6 (radians under a degree header: π/2 rad is 90°) and yaw rates that never

@@ -659,3 +659,50 @@ fn dropouts_in_the_optional_channels_are_named_or_filled() {
     .unwrap_err();
     assert!(matches!(&e, DataError::BadCell { row: 2, .. }), "{e}");
 }
+
+#[test]
+fn a_placeholder_heading_course_or_speed_is_refused_when_the_ship_turns() {
+    let (cols, lim, path) = (Columns::default(), Limits::default(), Path::new("t.csv"));
+    // 100 s at 0.1 °/s: the rate turns the ship through 10°
+    let mut r = Record::from_uy(
+        "r",
+        1.0,
+        (0..100).map(|i| (i % 7) as f64).collect(),
+        vec![0.1; 100],
+    );
+    r.y[0] = 0.0;
+    r.psi = Some(vec![0.0; 100]);
+    let e = validate_record(&r, path, &lim, &cols).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "t.csv: column `psi_deg` holds one value (0) throughout while the yaw rate turns the \
+         ship through 10°: a heading sensor not logged? Leave the channel out (its --col-… \
+         option naming no column)"
+    );
+    // a heading that follows the turn passes; a course stuck at one value does not, with
+    // its drop-outs skipped
+    r.psi = Some((0..100).map(|i| 0.1 * i as f64).collect());
+    r.cog = Some(
+        (0..100)
+            .map(|i| if i % 9 == 0 { f64::NAN } else { 42.0 })
+            .collect(),
+    );
+    let e = validate_record(&r, path, &lim, &cols).unwrap_err();
+    assert!(
+        matches!(&e, DataError::NoExcitation { column, .. } if column == "cog_deg"),
+        "{e}"
+    );
+    r.cog = None;
+    // a speed is refused only at 0 throughout (a constant nominal speed is a choice)
+    r.speed = Some(vec![1.5; 100]);
+    assert!(validate_record(&r, path, &lim, &cols).is_ok());
+    r.speed = Some(vec![0.0; 100]);
+    assert!(validate_record(&r, path, &lim, &cols).is_err());
+    // a ship that turns through less than MIN_TURN_DEG may hold its heading
+    let mut straight = r.clone();
+    straight.speed = None;
+    straight.y = vec![0.0; 100];
+    straight.y[50] = 0.04;
+    straight.psi = Some(vec![7.0; 100]);
+    assert!(validate_record(&straight, path, &lim, &cols).is_ok());
+}
