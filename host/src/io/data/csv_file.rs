@@ -199,7 +199,7 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
         // below where --fill-gaps allows, else an error that names the option
         let optional = |idx: usize| -> Result<f64, DataError> {
             let s = row.get(idx).unwrap_or("");
-            if s.is_empty() || s.eq_ignore_ascii_case("nan") {
+            if dropout(s) {
                 if cols.fill_gaps > 0 {
                     return Ok(f64::NAN);
                 }
@@ -264,7 +264,7 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
         if let (Some(i), Some(v)) = (icog, rec.cog.as_mut()) {
             // a GPS drop-out leaves the course empty (or NaN): missing, not an error
             let s = row.get(i).unwrap_or("");
-            let missing = s.is_empty() || s.eq_ignore_ascii_case("nan");
+            let missing = dropout(s);
             // degrees whatever --angle-unit says, as the navigation reader takes it (and
             // with its words for a cell that is not a number)
             let c = if missing {
@@ -323,6 +323,11 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
         }
     }
     Ok(rec)
+}
+
+/// Whether a cell of an optional channel marks a sensor's drop-out: empty or `NaN`.
+fn dropout(cell: &str) -> bool {
+    cell.is_empty() || cell.eq_ignore_ascii_case("nan")
 }
 
 /// Fills the NaN samples of `v` (dropouts) by linear interpolation between their
