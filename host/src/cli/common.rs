@@ -316,7 +316,7 @@ impl ReadArgs {
     /// `.nmea` and `.nmea0183` are NMEA, `.csv` and `.tsv` tables — and for a logger's
     /// `.log` or `.txt` by its text (NMEA sentences start with `$`, which no table holds);
     /// any other name by whether its first line is a sentence.
-    fn is_nmea(&self, path: &Path, text: &str) -> bool {
+    pub fn is_nmea(&self, path: &Path, text: &str) -> bool {
         let ext = path
             .extension()
             .map(|e| e.to_string_lossy().to_ascii_lowercase())

@@ -347,9 +347,34 @@ fn fuzz_readers_and_compare_never_panic_nor_report_non_finite_figures() {
         );
         report(&mut c_json, o);
     }
+    // `split` cuts the same mutated tables: every piece it reports lies in the text, and
+    // the pieces hold every row once
+    let mut c_split = Counts::default();
+    let mut rng = ChaCha8Rng::seed_from_u64(0x5eed_5b17);
+    for _ in 0..10_000 {
+        let bytes = mutate(&mut rng, &csv);
+        let text = data::decode_text(&bytes);
+        let o = case(
+            || data::split_at_gaps(&text, p_csv, "t_s", 1.0).map_err(anyhow::Error::from),
+            |s| {
+                assert!((0..s.pieces.len()).all(|i| s.piece_text(&text, i).is_some()));
+                assert!(s
+                    .pieces
+                    .windows(2)
+                    .all(|w| w[0].first_row + w[0].rows == w[1].first_row));
+                Counts {
+                    cases: 1,
+                    successes: 1,
+                    ..Counts::default()
+                }
+            },
+        );
+        report(&mut c_split, o);
+    }
     let mut all = Counts::default();
     for (name, c) in [
         ("CSV records", &c_csv),
+        ("CSV records cut by split", &c_split),
         ("blobs", &c_blob),
         ("blobs, payload mutated and sealed", &c_sealed),
         ("JSON models", &c_json),
@@ -364,12 +389,12 @@ fn fuzz_readers_and_compare_never_panic_nor_report_non_finite_figures() {
         "fuzz {:<34} cases {:>6}  errors {:>6}  successes {:>6}  panics {}  non-finite successes {}",
         "all", all.cases, all.errors, all.successes, all.panics, all.non_finite
     );
-    assert!(all.cases >= 100_000, "{all:?}");
+    assert!(all.cases >= 110_000, "{all:?}");
     assert_eq!(all.panics, 0, "{all:?}");
     assert_eq!(all.non_finite, 0, "{all:?}");
     // Both outcomes are reached: the mutator is neither too weak nor too wild (a raw blob
     // mutation rarely survives the CRC; the sealed ones reach the model checks).
-    for c in [&c_csv, &c_sealed, &c_json] {
+    for c in [&c_csv, &c_split, &c_sealed, &c_json] {
         assert!(c.errors > 100 && c.successes > 100, "{c:?}");
     }
     assert!(c_blob.errors > 10_000, "{c_blob:?}");

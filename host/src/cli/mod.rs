@@ -14,6 +14,7 @@ pub mod hil;
 pub mod pipeline;
 pub mod resid;
 pub mod simulate;
+pub mod split;
 
 /// yawcast — ship trials to a yaw-rate predictor that runs on the ship's controller.
 ///
@@ -64,6 +65,8 @@ pub enum Command {
     /// The whole story on the built-in ship with a hidden effect, ending in report.html.
     #[command(allow_negative_numbers = true)]
     Demo(demo::DemoArgs),
+    /// Cut record tables at their gaps and clock restarts into pieces read whole.
+    Split(split::SplitArgs),
     /// Hardware in the loop: the simulator sails, the firmware (QEMU or a board) predicts.
     #[command(allow_negative_numbers = true)]
     Hil(hil::HilArgs),
@@ -83,6 +86,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Diagnose(a) => diagnose::run(a),
         Command::Augment(a) => augment::run(a),
         Command::Demo(a) => demo::run(a),
+        Command::Split(a) => split::run(a),
     }
 }
 

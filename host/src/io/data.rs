@@ -12,6 +12,7 @@ mod atomic;
 mod checks;
 mod csv_file;
 mod heading;
+mod split;
 #[cfg(test)]
 mod tests;
 mod timestamp;
@@ -22,7 +23,7 @@ pub use atomic::{
 };
 pub use checks::{
     check_uniform, unit_warnings, unwrap_degrees, validate_record, Limits, MIN_COMMAND_SPAN_DEG,
-    MIN_RATE_SPAN_DEGPS, MIN_TURN_DEG,
+    MIN_RATE_SPAN_DEGPS, MIN_TURN_DEG, RUDDER_MAX_DEG,
 };
 pub(crate) use csv_file::Dialect;
 pub use csv_file::{
@@ -30,6 +31,7 @@ pub use csv_file::{
     write_csv, Columns,
 };
 pub use heading::{block_mean, heading_bias, HeadingBias};
+pub use split::{split_at_gaps, Break, BreakKind, Piece, Split};
 pub(crate) use timestamp::days_from_civil;
 
 /// Relative distance within which the fitted sample period is snapped to a value with at

@@ -9,7 +9,7 @@ fn help_lists_every_subcommand() {
     let out = stdout(&o);
     for c in [
         "simulate", "identify", "tune", "average", "export", "compare", "resid", "diagnose",
-        "augment", "demo", "hil",
+        "augment", "demo", "hil", "split",
     ] {
         assert!(
             out.lines().any(|l| l.trim_start().starts_with(c)),
@@ -599,4 +599,127 @@ fn navigation_input_errors_name_row_and_column_and_jumps_are_counted() {
         );
         assert!(first.contains(want), "{name}: {first}");
     }
+}
+
+#[test]
+fn split_cuts_a_log_at_its_gaps_and_clock_restarts_into_records_read_whole() {
+    let d = scratch("split");
+    let m = write_model(&d);
+    // one logger file: 200 rows, 5 missing, 395 rows; a second run from t = 0 (300 rows);
+    // 20 samples missing, then a 50-row fragment
+    let run1: Vec<String> = csv_text(600, 0.5).lines().map(str::to_string).collect();
+    let run2: Vec<String> = csv_text(300, 0.5).lines().map(str::to_string).collect();
+    let mut rows: Vec<String> = run1[1..=200].to_vec();
+    rows.extend_from_slice(&run1[206..]);
+    rows.extend_from_slice(&run2[1..]);
+    for i in 0..50 {
+        rows.push(format!("{},10,0.1", 160.0 + 0.5 * i as f64));
+    }
+    let header = &run1[0];
+    let log = d.join("log.csv");
+    std::fs::write(&log, format!("{header}\n{}\n", rows.join("\n"))).unwrap();
+    let o = run(&[
+        "compare",
+        "--model",
+        m.to_str().unwrap(),
+        "--data",
+        log.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 2);
+    assert!(
+        stderr(&o).contains("row 201") && stderr(&o).contains("yawcast split"),
+        "{}",
+        stderr(&o)
+    );
+    let (out, json) = (d.join("pieces"), d.join("split.json"));
+    let o = run(&[
+        "split",
+        "--data",
+        log.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let text = stdout(&o);
+    assert!(
+        text.contains("before row 201: a gap of 3.000 s (5 samples missing)")
+            && text.contains("before row 596: the clock goes back 299.500 s")
+            && text.contains("left out: rows 896–945 (50 samples"),
+        "{text}"
+    );
+    // the pieces hold the header and their rows byte for byte
+    let piece = |k: usize| std::fs::read_to_string(out.join(format!("log_{k}.csv"))).unwrap();
+    let want = |r: &[String]| format!("{header}\n{}\n", r.join("\n"));
+    assert_eq!(piece(1), want(&rows[..200]));
+    assert_eq!(piece(2), want(&rows[200..595]));
+    assert_eq!(piece(3), want(&rows[595..895]));
+    assert!(!out.join("log_4.csv").exists());
+    for k in 1..=3 {
+        let p = out.join(format!("log_{k}.csv"));
+        let o = run(&[
+            "compare",
+            "--model",
+            m.to_str().unwrap(),
+            "--data",
+            p.to_str().unwrap(),
+        ]);
+        assert_eq!(code(&o), 0, "piece {k}: {}", stderr(&o));
+    }
+    // the summary's field names are a contract
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(v["min_samples"], 100);
+    let f = &v["files"][0];
+    assert_eq!(f["data"], log.to_str().unwrap());
+    assert_eq!(f["period_s"], 0.5);
+    let breaks: Vec<(u64, &str, f64)> = f["breaks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| {
+            (
+                b["row"].as_u64().unwrap(),
+                b["kind"].as_str().unwrap(),
+                b["step_s"].as_f64().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        breaks,
+        vec![
+            (201, "gap", 3.0),
+            (596, "clock-back", -299.5),
+            (896, "gap", 10.5)
+        ]
+    );
+    let pieces = f["pieces"].as_array().unwrap();
+    assert_eq!(pieces.len(), 4);
+    assert_eq!(pieces[1]["file"], out.join("log_2.csv").to_str().unwrap());
+    assert_eq!(
+        (
+            &pieces[1]["first_row"],
+            &pieces[1]["rows"],
+            &pieces[1]["start_s"],
+            &pieces[1]["duration_s"]
+        ),
+        (
+            &serde_json::json!(201),
+            &serde_json::json!(395),
+            &serde_json::json!(102.5),
+            &serde_json::json!(197.0)
+        )
+    );
+    assert!(pieces[3]["file"].is_null());
+    // NMEA logs are not tables
+    let nmea = data_dir().join("trial.nmea");
+    let o = run(&[
+        "split",
+        "--data",
+        nmea.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 2);
+    assert!(stderr(&o).contains("NMEA"), "{}", stderr(&o));
 }

@@ -279,6 +279,9 @@ fn exit_codes_follow_one_contract() {
         ("augment, --ship under a file", 2, "augment --model {model} --effect bias --data {d}/short.csv --out {d}/aug3 --ship {d}/file/s.toml"),
         ("hil, --steps 0", 2, "hil --model {model} --steps 0"),
         ("demo, --duration 0", 2, "demo --duration 0 --out {d}/demo"),
+        ("split", 0, "split --data {d}/short.csv --out {d}/pieces --json {d}/split.json"),
+        ("split, --min-samples beyond every piece", 2, "split --data {d}/short.csv --min-samples 301 --out {d}/pieces2"),
+        ("split, --out under a file", 2, "split --data {d}/short.csv --out {d}/file/p"),
     ];
     let mut failures = Vec::new();
     for (name, expected, args) in cases {
@@ -319,6 +322,8 @@ fn exit_codes_follow_one_contract() {
         "cmp.json",
         "plots/acf.svg",
         "aug.postcard",
+        "pieces/short_1.csv",
+        "split.json",
     ] {
         assert!(d.join(f).exists(), "{f} missing");
     }
@@ -330,6 +335,8 @@ fn exit_codes_follow_one_contract() {
         "aug3.postcard",
         "t.postcard",
         "demo",
+        "pieces2",
+        "file/p",
     ] {
         assert!(!d.join(f).exists(), "{f} written by a refused run");
     }

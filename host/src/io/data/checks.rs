@@ -193,11 +193,18 @@ pub fn validate_record(
 /// speed over ground that holds one value is refused as a placeholder ([`validate_record`]).
 pub const MIN_TURN_DEG: f64 = 5.0;
 
+/// The largest angle a rudder turns (deg); a logged command beyond it is asked about by
+/// [`unit_warnings`] (a rudder in per cent of its largest angle).
+pub const RUDDER_MAX_DEG: f64 = 45.0;
+
 /// Warnings about the scale of a record's columns that suggest a unit mix-up: commands that
 /// never leave ±1.6 (radians under a degree header: π/2 rad is 90°) and yaw rates that never
 /// leave ±0.05 °/s while the commands reach 2° (rad/s under a °/s header: a ship turning
 /// visibly does more than 3°/min), and a sample time above a minute (milliseconds under a
-/// seconds header: no yaw predictor samples that slowly). Where the heading is logged and
+/// seconds header: no yaw predictor samples that slowly), and commands beyond
+/// [`RUDDER_MAX_DEG`] (a rudder logged in per cent of its largest angle: rudders turn
+/// 35–45°; azimuth pods turn further, so this is a question, not a refusal). Where the
+/// heading is logged and
 /// the record turns, the heading says it outright: it turns about 57.3 times what a yaw rate
 /// in rad/s integrates to, and −1 times what one of the other sign does (a gyro positive to
 /// port). Empty when nothing looks wrong.
@@ -213,6 +220,8 @@ pub const MIN_TURN_DEG: f64 = 5.0;
 /// assert!(unit_warnings(&Record::from_uy("r", 1.0, vec![10.0, -20.0], vec![0.4, -0.9])).is_empty());
 /// let ms = Record::from_uy("r", 1000.0, vec![10.0, -20.0], vec![0.4, -0.9]);
 /// assert!(unit_warnings(&ms)[0].contains("milliseconds"));
+/// let pct = Record::from_uy("r", 1.0, vec![57.1, -57.1], vec![0.4, -0.9]);
+/// assert!(unit_warnings(&pct)[0].contains("--command-scale"));
 /// ```
 pub fn unit_warnings(rec: &Record) -> Vec<String> {
     let span = |v: &[f64]| {
@@ -226,6 +235,13 @@ pub fn unit_warnings(rec: &Record) -> Vec<String> {
         out.push(format!(
             "the sample time is {} s: if the time column is in milliseconds, give --time-unit ms",
             rec.ts
+        ));
+    }
+    if du > RUDDER_MAX_DEG {
+        out.push(format!(
+            "the commands reach ±{du:.1}, more than a rudder turns (35–45°): if they are per \
+             cent of the rudder's largest angle, give --command-scale (0.35 for a 35° rudder); \
+             an azimuth pod's angle is right as logged"
         ));
     }
     if du > 0.0 && du <= 1.6 {
@@ -372,7 +388,11 @@ pub fn check_uniform(t: &[f64], path: &Path) -> Result<f64, DataError> {
     for i in 0..n - 1 {
         let step = t[i + 1] - t[i];
         let what = if step.is_nan() || step < 0.0 {
-            Some("time goes back".to_string())
+            Some(
+                "time goes back (a clock restart, or two runs in one file: `yawcast split` \
+                 cuts the record there)"
+                    .to_string(),
+            )
         } else if step == 0.0 {
             Some("the time stamp repeats the row before".to_string())
         } else {
@@ -380,7 +400,8 @@ pub fn check_uniform(t: &[f64], path: &Path) -> Result<f64, DataError> {
             if periods >= 2.0 {
                 let missing = periods - 1.0;
                 Some(format!(
-                    "{missing} sample{} missing; split the record there or fill the gap",
+                    "{missing} sample{} missing; split the record there (`yawcast split`) or fill \
+                     the gap",
                     if missing == 1.0 { "" } else { "s" }
                 ))
             } else if periods < 1.0 {

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use super::timestamp::{parse_clock, parse_iso8601, Stamp};
+use super::timestamp::Clock;
 use super::{check_uniform, unwrap_degrees, write_atomic, DataError, Record};
 
 /// Column names of the measurement CSV (overridable for other loggers).
@@ -91,15 +91,6 @@ pub fn read_csv_with(path: &Path, cols: &Columns) -> Result<Record, DataError> {
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
     parse_csv(&text, path, &name, cols)
-}
-
-/// What the time column holds, decided by its first row: seconds, ISO 8601 date-times
-/// (from the first stamp), or times of day alone (from the first, with the midnights
-/// crossed so far).
-enum Clock {
-    Seconds,
-    Iso(Stamp),
-    Day(Stamp, i64),
 }
 
 /// Parses CSV text (`path` only labels errors).
@@ -216,31 +207,21 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
         // holds one (then seconds from that first stamp)
         let raw_t = row.get(it).unwrap_or("");
         if rown == 1 {
-            clock = if let Some(stamp) = parse_iso8601(raw_t) {
-                Clock::Iso(stamp)
-            } else if let Some(stamp) = parse_clock(raw_t) {
-                Clock::Day(stamp, 0)
-            } else {
-                Clock::Seconds
-            };
+            clock = Clock::of(raw_t);
         }
-        let bad_time = || DataError::BadTime {
-            path: path.to_path_buf(),
-            row: rown,
-            column: headers[it].clone(),
-            value: raw_t.to_string(),
-        };
-        let t = match &mut clock {
-            Clock::Seconds => cell(it)? * cols.time_scale,
-            Clock::Iso(origin) => parse_iso8601(raw_t).ok_or_else(bad_time)?.since(origin),
-            Clock::Day(origin, days) => {
-                let t = parse_clock(raw_t).ok_or_else(bad_time)?.since(origin);
-                // a time of day that falls back by more than half a day crossed midnight
-                let last = rec.t.last().copied().unwrap_or(0.0);
-                if t + 86_400.0 * (*days as f64) < last - 43_200.0 {
-                    *days += 1;
-                }
-                t + 86_400.0 * (*days as f64)
+        let last = rec.t.last().copied().unwrap_or(0.0);
+        let number = |c: &str| dialect.number(c).ok().filter(|v| v.is_finite());
+        let t = match clock.seconds(raw_t, number, cols.time_scale, last) {
+            Some(t) => t,
+            // a number's error names the cell as any other column's does
+            None if clock == Clock::Seconds => cell(it)?,
+            None => {
+                return Err(DataError::BadTime {
+                    path: path.to_path_buf(),
+                    row: rown,
+                    column: headers[it].clone(),
+                    value: raw_t.to_string(),
+                })
             }
         };
         rec.t.push(t);

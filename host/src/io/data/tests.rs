@@ -706,3 +706,25 @@ fn a_placeholder_heading_course_or_speed_is_refused_when_the_ship_turns() {
     straight.psi = Some(vec![7.0; 100]);
     assert!(validate_record(&straight, path, &lim, &cols).is_ok());
 }
+
+#[test]
+fn commands_beyond_a_rudder_are_asked_about_as_per_cent() {
+    let rec = |amp: f64| {
+        let u: Vec<f64> = (0..200)
+            .map(|t| if (t / 20) % 2 == 0 { amp } else { -amp })
+            .collect();
+        let y: Vec<f64> = (0..200).map(|t| 0.5 * (0.1 * t as f64).sin()).collect();
+        Record::from_uy("r", 1.0, u, y)
+    };
+    // 20° of a 35° rudder, logged in per cent: 57.1
+    let w = unit_warnings(&rec(20.0 / 0.35));
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].contains("±57.1") && w[0].contains("--command-scale (0.35"),
+        "{w:?}"
+    );
+    // at the limit and below it nothing is asked
+    assert!(unit_warnings(&rec(RUDDER_MAX_DEG)).is_empty());
+    assert!(unit_warnings(&rec(35.0)).is_empty());
+    assert_eq!(unit_warnings(&rec(RUDDER_MAX_DEG + 0.1)).len(), 1);
+}

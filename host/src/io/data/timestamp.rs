@@ -144,6 +144,56 @@ pub(crate) fn parse_clock(s: &str) -> Option<Stamp> {
     }
 }
 
+/// What a time column holds, decided by its first cell: seconds (numbers), ISO 8601
+/// date-times, or times of day alone (counting the midnights crossed so far). Later cells
+/// are read as seconds from the first stamp.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Clock {
+    /// Numbers, in the column's unit.
+    Seconds,
+    /// ISO 8601 date-times, from this first stamp.
+    Iso(Stamp),
+    /// Times of day, from this first one, with the midnights crossed.
+    Day(Stamp, i64),
+}
+
+impl Clock {
+    /// The clock of a column whose first cell is `first`.
+    pub(crate) fn of(first: &str) -> Clock {
+        if let Some(stamp) = parse_iso8601(first) {
+            Clock::Iso(stamp)
+        } else if let Some(stamp) = parse_clock(first) {
+            Clock::Day(stamp, 0)
+        } else {
+            Clock::Seconds
+        }
+    }
+
+    /// The time (s) of the cell `raw`: a number through `number`, times `scale`, or a stamp
+    /// of this clock from the first; `last` is the row before's time (a time of day that
+    /// falls back by more than half a day crossed midnight). `None` when the cell is not a
+    /// time of this clock.
+    pub(crate) fn seconds(
+        &mut self,
+        raw: &str,
+        number: impl Fn(&str) -> Option<f64>,
+        scale: f64,
+        last: f64,
+    ) -> Option<f64> {
+        match self {
+            Clock::Seconds => number(raw).map(|v| v * scale),
+            Clock::Iso(origin) => Some(parse_iso8601(raw)?.since(origin)),
+            Clock::Day(origin, days) => {
+                let t = parse_clock(raw)?.since(origin);
+                if t + 86_400.0 * (*days as f64) < last - 43_200.0 {
+                    *days += 1;
+                }
+                Some(t + 86_400.0 * (*days as f64))
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
