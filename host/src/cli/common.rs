@@ -190,9 +190,11 @@ pub struct ReadArgs {
     /// missing sample is an error naming its row.
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub fill_gaps: usize,
-    /// CSV without a rate gyro: the yaw rate is the heading's change over each sample,
-    /// (ψ_t − ψ_{t−1})/Ts, the first sample taking the second's; a yaw-rate column is not
-    /// read. The controller must form its measurement the same way.
+    /// Without a rate gyro: the yaw rate is the heading's change over each sample,
+    /// (ψ_t − ψ_{t−1})/Ts, the first sample taking the second's; a CSV's yaw-rate column or
+    /// an NMEA log's ROT sentences are not read (NMEA: the HDT/HDG heading sets the grid,
+    /// and the log's ZDA/RMC clock is needed). The controller must form its measurement
+    /// the same way.
     #[arg(long)]
     pub rate_from_heading: bool,
     /// NMEA logs without a ZDA/RMC clock: the rate (Hz) at which ROT sentences arrive.
@@ -309,6 +311,7 @@ impl ReadArgs {
             ts: self.nmea_ts,
             max_gap: self.max_gap,
             skip_bad_checksums: self.skip_bad_checksums,
+            rate_from_heading: self.rate_from_heading,
         }
     }
 
@@ -354,24 +357,18 @@ impl ReadArgs {
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
         let is_nmea = self.is_nmea(path, &text);
-        if is_nmea && self.rate_from_heading {
-            return Err(bad(format!(
-                "{}: --rate-from-heading reads CSV records; an NMEA log gives the rate of turn \
-                 in its ROT sentences",
-                path.display()
-            )));
-        }
         if !(self.command_scale.is_finite() && self.command_scale != 0.0) {
             return Err(bad(format!(
                 "--command-scale {}: expected a non-zero number",
                 self.command_scale
             )));
         }
-        let (mut rec, cols) = if is_nmea {
+        let (mut rec, mut cols) = if is_nmea {
             let rec = nmea::parse_nmea(&text, path, &name, &self.nmea())?;
             let cols = Columns {
                 u: "RSA rudder angle".into(),
                 y: "ROT rate of turn".into(),
+                psi: "HDT/HDG heading".into(),
                 speed: "VTG speed over ground".into(),
                 wind_speed: "MWV wind speed".into(),
                 ..Columns::default()
@@ -383,6 +380,10 @@ impl ReadArgs {
         };
         if self.command_scale != 1.0 {
             rec.u.iter_mut().for_each(|u| *u *= self.command_scale);
+        }
+        if self.rate_from_heading {
+            // the checks name the channel the rate was formed from
+            cols.y = format!("{}'s change per sample (--rate-from-heading)", cols.psi);
         }
         data::validate_record(&rec, path, &self.limits()?, &cols)?;
         Ok(rec)

@@ -4,7 +4,7 @@
 //!
 //! | sentence | channel | unit conversion |
 //! |---|---|---|
-//! | `$--ROT` rate of turn | yaw rate `r` (required) | deg/min → deg/s; `-` = bow to port |
+//! | `$--ROT` rate of turn | yaw rate `r` (required; not read with [`NmeaOptions::rate_from_heading`]) | deg/min → deg/s; `-` = bow to port |
 //! | `$--RSA` rudder sensor angle | angle `δ` (required) | deg; both sensors valid → their mean |
 //! | `$--HDT` true heading | heading `ψ` | deg (unwrapped) |
 //! | `$--HDG` magnetic heading | heading `ψ` when no HDT | sensor + deviation + variation (E +) |
@@ -41,7 +41,8 @@
 //!
 //! Every channel present is linearly interpolated (heading and wind angle after unwrapping)
 //! onto a uniform grid of step [`NmeaOptions::ts`] (default: the usual `ROT` spacing, rounded
-//! to 1 ms) over the time span where every present channel has data. `t_s` counts from the
+//! to 1 ms; the heading's with [`NmeaOptions::rate_from_heading`], whose yaw rate is then the
+//! heading's change over each grid step) over the time span where every present channel has data. `t_s` counts from the
 //! first grid point. A channel whose samples are further apart than the gap limit anywhere
 //! in that span is an error naming the channel, the clock time and line where the gap starts,
 //! and its length. The limit is [`NmeaOptions::max_gap`], by default the larger of two grid
@@ -78,6 +79,10 @@ pub struct NmeaOptions {
     pub max_gap: Option<f64>,
     /// Drop sentences with a bad or missing checksum instead of failing.
     pub skip_bad_checksums: bool,
+    /// No rate of turn: the yaw rate is the heading's change over each grid step
+    /// ([`crate::io::data::heading_rate`]); `ROT` sentences are not read, `HDT`/`HDG` are
+    /// required and set the grid step. Needs the log's clock ([`Clock::Log`]).
+    pub rate_from_heading: bool,
 }
 
 impl Default for NmeaOptions {
@@ -87,6 +92,7 @@ impl Default for NmeaOptions {
             ts: None,
             max_gap: None,
             skip_bad_checksums: false,
+            rate_from_heading: false,
         }
     }
 }
@@ -146,7 +152,7 @@ pub enum NmeaError {
         message: String,
     },
     /// A required channel has no valid sample.
-    #[error("{path}: no valid {sentence} sentence ({what}); it is required")]
+    #[error("{path}: no valid {sentence} sentence ({what}); it is required{hint}")]
     Missing {
         /// File concerned.
         path: PathBuf,
@@ -154,6 +160,8 @@ pub enum NmeaError {
         sentence: &'static str,
         /// What it carries.
         what: &'static str,
+        /// What else would do, with its leading separator (empty when nothing would).
+        hint: &'static str,
     },
     /// A channel has a hole longer than the gap limit.
     #[error("{path}: gap of {length:.2} s in {sentence} ({what}) after {at} (line {line}); the limit is {limit:.2} s (--max-gap)")]
@@ -287,6 +295,13 @@ pub fn parse_nmea(
     opts: &NmeaOptions,
 ) -> Result<Record, NmeaError> {
     if let Clock::Rate(hz) = opts.clock {
+        if opts.rate_from_heading {
+            return Err(NmeaError::Option(
+                "the rate from the heading needs the log's ZDA/RMC clock; --nmea-rate counts \
+                 ROT sentences"
+                    .to_string(),
+            ));
+        }
         if !(hz.is_finite() && hz > 0.0) {
             return Err(NmeaError::Option(format!(
                 "the ROT rate must be a positive number of Hz, found {hz}"
@@ -740,20 +755,32 @@ fn timestamp(
 
 /// Pass 3: gap check and resampling onto the grid.
 fn resample(
-    series: Series,
+    mut series: Series,
     path: &Path,
     name: &str,
     opts: &NmeaOptions,
 ) -> Result<Record, NmeaError> {
-    for (ch, sentence, what) in [
-        (Chan::Rate, "ROT", "rate of turn"),
-        (Chan::Angle, "RSA", "rudder sensor angle"),
-    ] {
-        if !series.get(&ch).is_some_and(|v| v.len() >= 2) {
+    // the channel that sets the grid: the rate of turn, or the heading it is formed from
+    let (base, required) = if opts.rate_from_heading {
+        series.remove(&Chan::Rate);
+        (Chan::Heading, (Chan::Heading, "HDT/HDG", "heading"))
+    } else {
+        (Chan::Rate, (Chan::Rate, "ROT", "rate of turn"))
+    };
+    let has = |ch: Chan| series.get(&ch).is_some_and(|v| v.len() >= 2);
+    for (ch, sentence, what) in [required, (Chan::Angle, "RSA", "rudder sensor angle")] {
+        if !has(ch) {
+            let hint = if ch == Chan::Rate && has(Chan::Heading) {
+                "; without a rate gyro, --rate-from-heading forms the yaw rate from the \
+                 HDT/HDG heading"
+            } else {
+                ""
+            };
             return Err(NmeaError::Missing {
                 path: path.to_path_buf(),
                 sentence,
                 what,
+                hint,
             });
         }
     }
@@ -772,7 +799,7 @@ fn resample(
     let ts = match opts.ts {
         Some(ts) => ts,
         None => {
-            let s = spacing(&series[&Chan::Rate]);
+            let s = spacing(&series[&base]);
             ((s * 1000.0).round() / 1000.0).max(0.001)
         }
     };
@@ -836,6 +863,11 @@ fn resample(
             }
             // read by parse_nmea_nav, filtered out before
             Chan::Course | Chan::Lat | Chan::Lon => {}
+        }
+    }
+    if opts.rate_from_heading {
+        if let Some(psi) = rec.psi.as_ref() {
+            rec.y = crate::io::data::heading_rate(psi, ts);
         }
     }
     Ok(rec)

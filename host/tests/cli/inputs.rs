@@ -229,6 +229,58 @@ fn nmea_logs_are_read_and_their_errors_named() {
         "{}",
         stderr(&o)
     );
+
+    // a log with no rate gyro on the bus (no ROT): refused, naming --rate-from-heading;
+    // with it the heading's change is the yaw rate
+    let sentence = |body: String| {
+        let sum = body.bytes().fold(0u8, |a, b| a ^ b);
+        format!("${body}*{sum:02X}\n")
+    };
+    let mut log = String::new();
+    for s in 0..120 {
+        log += &sentence(format!(
+            "GPZDA,12{:02}{:02}.00,14,06,2024,00,00",
+            s / 60,
+            s % 60
+        ));
+        for half in 0..2 {
+            let t = s as f64 + 0.5 * half as f64;
+            let delta = if (t / 8.0).floor() as i64 % 2 == 0 {
+                10.0
+            } else {
+                -10.0
+            };
+            log += &sentence(format!("IIRSA,{delta:.1},A,,V"));
+            log += &sentence(format!("HEHDT,{:.2},T", 90.0 + 8.0 * (0.15 * t).sin()));
+        }
+    }
+    let no_rot = d.join("no-rot.nmea");
+    std::fs::write(&no_rot, log).unwrap();
+    let compare = |extra: &[&str]| {
+        let mut args = vec![
+            "compare",
+            "--model",
+            p.to_str().unwrap(),
+            "--data",
+            no_rot.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        run(&args)
+    };
+    let o = compare(&[]);
+    assert_eq!(code(&o), 2);
+    assert!(
+        stderr(&o).contains("no valid ROT sentence") && stderr(&o).contains("--rate-from-heading"),
+        "{}",
+        stderr(&o)
+    );
+    let o = compare(&["--rate-from-heading"]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    assert!(stdout(&o).contains("no-rot"), "{}", stdout(&o));
+    // the ROT count is no clock for it
+    let o = compare(&["--rate-from-heading", "--nmea-rate", "2"]);
+    assert_eq!(code(&o), 2);
+    assert!(stderr(&o).contains("ZDA/RMC clock"), "{}", stderr(&o));
 }
 
 #[test]

@@ -234,3 +234,63 @@ fn a_record_written_as_a_log_reads_back() {
     let v = back.speed.as_ref().unwrap();
     assert!((v[2] - 3.2).abs() < 1e-4, "{v:?}");
 }
+
+#[test]
+fn without_rot_the_heading_gives_the_rate_when_asked() {
+    let opts = NmeaOptions {
+        rate_from_heading: true,
+        ..NmeaOptions::default()
+    };
+    // HDT at 1 Hz, 358 + 0.5 t: the grid is the heading's, the rate its change, ROT unread
+    let r = parse(TRIAL, &opts).unwrap();
+    assert_eq!(r.ts, 1.0);
+    let psi = r.psi.as_ref().unwrap();
+    assert_eq!(psi[0], 358.0);
+    assert_eq!(r.y, crate::io::data::heading_rate(psi, 1.0));
+    assert!(r.y.iter().all(|&y| y == 0.5), "{:?}", r.y);
+    assert!(r.len() >= 9, "{}", r.len());
+    // a log without ROT: refused, naming the option; read with it
+    let no_rot: String = TRIAL
+        .lines()
+        .filter(|l| !l.contains("ROT,"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let e = parse(&no_rot, &NmeaOptions::default()).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            NmeaError::Missing {
+                sentence: "ROT",
+                ..
+            }
+        ) && e.to_string().contains("--rate-from-heading"),
+        "{e}"
+    );
+    assert_eq!(parse(&no_rot, &opts).unwrap().y, r.y);
+    // without a heading either, nothing to form it from
+    let bare: String = no_rot
+        .lines()
+        .filter(|l| !l.contains("HDT,") && !l.contains("HDG,"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let e = parse(&bare, &NmeaOptions::default()).unwrap_err();
+    assert!(!e.to_string().contains("--rate-from-heading"), "{e}");
+    let e = parse(&bare, &opts).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            NmeaError::Missing {
+                sentence: "HDT/HDG",
+                ..
+            }
+        ),
+        "{e}"
+    );
+    // the ROT count is no clock for it
+    let counted = NmeaOptions {
+        clock: Clock::Rate(2.0),
+        ..opts
+    };
+    let e = parse(TRIAL, &counted).unwrap_err();
+    assert!(e.to_string().contains("ZDA/RMC clock"), "{e}");
+}
