@@ -292,18 +292,11 @@ pub fn parse_nav_csv(
     samples: usize,
     ts: f64,
 ) -> Result<Option<Nav>, NavError> {
-    let dialect = crate::io::data::Dialect::of(text);
-    let mut rdr = dialect.reader(text);
     let csv_err = |e: csv::Error| NavError::Csv {
         path: path.to_path_buf(),
         message: e.to_string(),
     };
-    let headers: Vec<String> = rdr
-        .headers()
-        .map_err(csv_err)?
-        .iter()
-        .map(str::to_string)
-        .collect();
+    let (dialect, mut rdr, headers) = crate::io::data::Dialect::table(text).map_err(csv_err)?;
     let find = |c: &str| headers.iter().position(|h| h == c);
     let pair = |a: &str, b: &str| -> Result<Option<(usize, usize)>, NavError> {
         match (find(a), find(b)) {

@@ -345,6 +345,21 @@ pub fn unwrap_degrees(psi: &mut [f64]) {
     }
 }
 
+/// A logger's period: the median of the time steps that go forward (`NaN` when none does).
+pub(crate) fn median_step(t: &[f64]) -> f64 {
+    let mut steps: Vec<f64> = t
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|s| *s > 0.0)
+        .collect();
+    steps.sort_by(f64::total_cmp);
+    match steps.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => steps[n / 2],
+        n => 0.5 * (steps[n / 2 - 1] + steps[n / 2]),
+    }
+}
+
 /// Checks that `t` advances one sample per period and returns the period.
 ///
 /// The period is the median of the steps that go forward. Logged time stamps jitter: a row
@@ -370,20 +385,7 @@ pub fn unwrap_degrees(psi: &mut [f64]) {
 /// ```
 pub fn check_uniform(t: &[f64], path: &Path) -> Result<f64, DataError> {
     let n = t.len();
-    // the period: the median of the steps that go forward
-    let mut steps: Vec<f64> = t
-        .windows(2)
-        .map(|w| w[1] - w[0])
-        .filter(|s| *s > 0.0)
-        .collect();
-    steps.sort_by(f64::total_cmp);
-    let h = if steps.is_empty() {
-        f64::NAN
-    } else if steps.len() % 2 == 1 {
-        steps[steps.len() / 2]
-    } else {
-        0.5 * (steps[steps.len() / 2 - 1] + steps[steps.len() / 2])
-    };
+    let h = median_step(t);
     // the first row that breaks the sampling, in row order
     for i in 0..n - 1 {
         let step = t[i + 1] - t[i];

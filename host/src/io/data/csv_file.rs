@@ -110,14 +110,7 @@ pub fn parse_csv(text: &str, path: &Path, name: &str, cols: &Columns) -> Result<
         path: path.to_path_buf(),
         message: e.to_string(),
     };
-    let dialect = Dialect::of(text);
-    let mut rdr = dialect.reader(text);
-    let headers: Vec<String> = rdr
-        .headers()
-        .map_err(csv_err)?
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+    let (dialect, mut rdr, headers) = Dialect::table(text).map_err(csv_err)?;
     for (j, h) in headers.iter().enumerate() {
         if let Some(k) = headers[..j].iter().position(|g| g == h) {
             return Err(DataError::DuplicateColumn {
@@ -512,6 +505,9 @@ pub(crate) struct Dialect {
     pub(crate) decimal_comma: bool,
 }
 
+/// A table opened by [`Dialect::table`]: its dialect, a reader over its rows, its header.
+pub(crate) type Table<'a> = (Dialect, csv::Reader<&'a [u8]>, Vec<String>);
+
 impl Dialect {
     /// The dialect of `text` (type docs).
     pub(crate) fn of(text: &str) -> Dialect {
@@ -542,6 +538,15 @@ impl Dialect {
             .comment(Some(b'#'))
             .delimiter(self.delimiter)
             .from_reader(text.as_bytes())
+    }
+
+    /// A table's dialect, a reader over its rows and its header's names: what every reader
+    /// of the records' tables opens with.
+    pub(crate) fn table(text: &str) -> Result<Table<'_>, csv::Error> {
+        let dialect = Dialect::of(text);
+        let mut rdr = dialect.reader(text);
+        let headers = rdr.headers()?.iter().map(str::to_string).collect();
+        Ok((dialect, rdr, headers))
     }
 
     /// `cell` as a number, its decimal comma read as a point where the dialect has one.

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
+use super::checks::median_step;
 use super::csv_file::Dialect;
 use super::timestamp::Clock;
 use super::DataError;
@@ -116,14 +117,7 @@ pub fn split_at_gaps(
         path: path.to_path_buf(),
         message: e.to_string(),
     };
-    let dialect = Dialect::of(text);
-    let mut rdr = dialect.reader(text);
-    let headers: Vec<String> = rdr
-        .headers()
-        .map_err(csv_err)?
-        .iter()
-        .map(str::to_string)
-        .collect();
+    let (dialect, mut rdr, headers) = Dialect::table(text).map_err(csv_err)?;
     let it =
         headers
             .iter()
@@ -176,17 +170,7 @@ pub fn split_at_gaps(
             needed: 2,
         });
     }
-    let mut fwd: Vec<f64> = t
-        .windows(2)
-        .map(|w| w[1] - w[0])
-        .filter(|s| *s > 0.0)
-        .collect();
-    fwd.sort_by(f64::total_cmp);
-    let period = match fwd.len() {
-        0 => f64::NAN,
-        n if n % 2 == 1 => fwd[n / 2],
-        n => 0.5 * (fwd[n / 2 - 1] + fwd[n / 2]),
-    };
+    let period = median_step(&t);
     let mut breaks = Vec::new();
     for (i, w) in t.windows(2).enumerate() {
         let step = w[1] - w[0];
