@@ -5,7 +5,7 @@
 #   bench/worlds/run.sh [--yawcast PATH] [--work DIR] [--worlds LIST] [--seeds N]
 #                       [--strengths LIST] [--effects LIST] [--jobs J] [--log-wind]
 #                       [--augment] [--won-back] [--trial-input KIND] [--ref-input KIND]
-#                       [--ts S]
+#                       [--ts S] [--noise-scale K] [--duration S]
 #
 #   --yawcast PATH    the binary (default: build the ci profile and use it)
 #   --work DIR        records, models and diagnoses (default target/bench-worlds)
@@ -40,6 +40,10 @@
 #   --ts S            the sample time of every record (`simulate --ts`; default the world's
 #                     own: 1 s, a scaled world's √(L/320) s) — the same 1 800 s sailed, logged
 #                     faster or slower
+#   --noise-scale K   every sensor's noise (gyro, heading, speed; reference and trials) times
+#                     K (default 1; 3 is a MEMS gyro's 0.09 °/s on the trials)
+#   --duration S      the length of every record, reference and trials (`simulate
+#                     --duration`; default 1 800 s)
 #
 # Per world: the reference is 3 records of the world's identification input (seeds 900–902,
 # gyro noise 0.02 °/s, heading noise 0.1°) and the model identified on them; each case is 3
@@ -68,6 +72,8 @@ wonback=0
 trialinput=prbs
 refinput=prbs
 ts=""
+noisescale=1
+duration=""
 while [ $# -gt 0 ]; do
     case "$1" in
         --yawcast) yawcast="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
@@ -83,6 +89,8 @@ while [ $# -gt 0 ]; do
         --trial-input) trialinput="$2"; shift 2 ;;
         --ref-input) refinput="$2"; shift 2 ;;
         --ts) ts="--ts $2"; shift 2 ;;
+        --noise-scale) noisescale="$2"; shift 2 ;;
+        --duration) duration="--duration $2"; shift 2 ;;
         -h|--help) sed -n '2,50p' "$0"; exit 0 ;;
         *) echo "unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
@@ -93,7 +101,11 @@ if [ -z "$yawcast" ]; then
 fi
 mkdir -p "$work"
 export YAWCAST="$yawcast" WORK="$work" LOGWIND="$logwind" AUGMENT="$augment" WONBACK="$wonback"
-export TRIALINPUT="$trialinput" TSARG="$ts"
+export TRIALINPUT="$trialinput" TSARG="$ts $duration"
+# the sensors' noise: the trials' (and the validation record's), the reference's
+scaled() { awk -v a="$1" -v k="$noisescale" 'BEGIN { print a * k }'; }
+export TRIALNOISE="--gyro-noise $(scaled 0.03) --heading-noise $(scaled 0.2) --speed-noise $(scaled 0.02)"
+refnoise=(--gyro-noise "$(scaled 0.02)" --heading-noise "$(scaled 0.1)")
 
 # a world's `simulate` arguments, one a line: NAME, or NAME@L for the world scaled to L m
 world_args() {
@@ -122,7 +134,7 @@ case_run() {
         eff+=(--strength "$strength")
     fi
     "$YAWCAST" simulate "${sim[@]}" $TSARG "${eff[@]}" --records 3 --seed $((100 * seed)) \
-        --input "$TRIALINPUT" --gyro-noise 0.03 --heading-noise 0.2 --speed-noise 0.02 $LOGWIND \
+        --input "$TRIALINPUT" $TRIALNOISE $LOGWIND \
         --out "$dir/trial.csv" >"$dir/simulate.log" 2>&1
     local refs=()
     for i in 1 2 3; do refs+=(--reference "$WORK/$world/ref-$i.csv"); done
@@ -159,8 +171,8 @@ print("+".join(e) if e else "none")' "$dir/augment.json")
         local fit10='import json,sys
 print(json.load(open(sys.argv[1]))["records"][0]["fit"]["10"])'
         if "$YAWCAST" simulate "${sim[@]}" $TSARG "${eff[@]}" --records 1 \
-            --seed $((100 * seed + 50)) --input "$TRIALINPUT" --gyro-noise 0.03 \
-            --heading-noise 0.2 --speed-noise 0.02 $LOGWIND --oracle-horizon 10 \
+            --seed $((100 * seed + 50)) --input "$TRIALINPUT" $TRIALNOISE \
+            $LOGWIND --oracle-horizon 10 \
             --out "$dir/val.csv" --json "$dir/val.json" >"$dir/won-back.log" 2>&1 \
             && "$YAWCAST" identify "${data[@]}" --out "$dir/linear" \
                 >>"$dir/won-back.log" 2>&1 \
@@ -204,9 +216,8 @@ for w in "${world_list[@]}"; do
     mapfile -t sim < <(world_args "$w")
     # a reference is reused only when it was sailed with the same options (a work directory
     # of another run, without the anemometer say, would otherwise serve a stale one)
-    # shellcheck disable=SC2206 # $logwind, $ts: one or two words, or none
-    refopts=(--records 3 --seed 900 --input "$refinput" --gyro-noise 0.02 --heading-noise 0.1
-        $logwind $ts)
+    # shellcheck disable=SC2206 # $logwind, $ts, $duration: one or two words, or none
+    refopts=(--records 3 --seed 900 --input "$refinput" "${refnoise[@]}" $logwind $ts $duration)
     stamp="${sim[*]} ${refopts[*]}"
     if [ ! -f "$work/$w/ref.postcard" ] \
         || [ "$(cat "$work/$w/ref.args" 2>/dev/null)" != "$stamp" ]; then
@@ -232,7 +243,8 @@ done
 xargs -P "$jobs" -L 1 bash -c 'case_run "$@"' _ <"$list" | sort >"$work/cases.tsv"
 secs=$(( $(date +%s) - start ))
 
-python3 - "$work/cases.tsv" "$secs" "$(nproc)" "$trialinput" "$refinput" "${ts#--ts }" <<'EOF'
+python3 - "$work/cases.tsv" "$secs" "$(nproc)" "$trialinput" "$refinput" "${ts#--ts }" \
+    "$noisescale" "${duration#--duration }" <<'EOF'
 import collections, sys
 allrows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
 rows = [r for r in allrows if "+" not in r[2]]
@@ -251,6 +263,10 @@ if (trialinput, refinput) != ("prbs", "prbs"):
     print(f"Trials sailed with `{trialinput}`, the reference with `{refinput}`.\n")
 if ts:
     print(f"Every record logged at Ts = {ts} s.\n")
+if sys.argv[7] != "1":
+    print(f"Every sensor's noise times {sys.argv[7]}.\n")
+if sys.argv[8]:
+    print(f"Every record {sys.argv[8]} s long.\n")
 if pairs:
     print("## Two effects: both named by the ranked verdict (verdict, then)\n")
     aug = any(r[6] != "-" for r in pairs)
