@@ -90,7 +90,8 @@ pub(super) fn second_effect(
             None => held_out(&ev[pick]),
         };
         let gj = held_out(&ev[j]);
-        if outpredicts(gj, gp) {
+        // current and wind: not gear dynamics
+        if outpredicts(gj, gp, false) {
             let words = format!(
                 "; named ahead of {} beside the first effect: it predicts the held-out \
                  records better at 10 steps ({:+.2} pp against {:+.2}) and in simulation \
