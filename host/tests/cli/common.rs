@@ -44,6 +44,13 @@ pub(crate) fn run(args: &[&str]) -> Output {
     bin().args(args).output().expect("runs the binary")
 }
 
+/// `yawcast compare --model MODEL --data DATA` and `extra` arguments.
+pub(crate) fn run_compare(model: &str, data: &str, extra: &[&str]) -> Output {
+    let mut args = vec!["compare", "--model", model, "--data", data];
+    args.extend_from_slice(extra);
+    run(&args)
+}
+
 pub(crate) fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }

@@ -30,13 +30,7 @@ fn bad_arguments_exit_2() {
 fn missing_file_is_bad_input_naming_it() {
     let d = scratch("missing");
     let m = write_model(&d);
-    let o = run(&[
-        "compare",
-        "--model",
-        m.to_str().unwrap(),
-        "--data",
-        "/nonexistent/trial.csv",
-    ]);
+    let o = run_compare(m.to_str().unwrap(), "/nonexistent/trial.csv", &[]);
     assert_eq!(code(&o), 2);
     let e = stderr(&o);
     assert!(e.starts_with("error: "), "{e}");
@@ -68,13 +62,7 @@ fn csv_errors_name_file_row_and_column() {
     for (name, text, needles) in cases {
         let f = d.join(name);
         std::fs::write(&f, text).unwrap();
-        let o = run(&[
-            "compare",
-            "--model",
-            m.to_str().unwrap(),
-            "--data",
-            f.to_str().unwrap(),
-        ]);
+        let o = run_compare(m.to_str().unwrap(), f.to_str().unwrap(), &[]);
         let e = stderr(&o);
         assert_eq!(code(&o), 2, "{name}: {e}");
         let first = e.lines().next().unwrap_or("");
@@ -190,24 +178,12 @@ fn nmea_logs_are_read_and_their_errors_named() {
     )
     .unwrap();
     let log = data_dir().join("trial.nmea");
-    let o = run(&[
-        "compare",
-        "--model",
-        p.to_str().unwrap(),
-        "--data",
-        log.to_str().unwrap(),
-    ]);
+    let o = run_compare(p.to_str().unwrap(), log.to_str().unwrap(), &[]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     assert!(stdout(&o).contains("trial"), "{}", stdout(&o));
 
     let bad = data_dir().join("trial-bad-checksum.nmea");
-    let o = run(&[
-        "compare",
-        "--model",
-        p.to_str().unwrap(),
-        "--data",
-        bad.to_str().unwrap(),
-    ]);
+    let o = run_compare(p.to_str().unwrap(), bad.to_str().unwrap(), &[]);
     assert_eq!(code(&o), 2);
     assert!(
         stderr(&o).contains("line 49: bad checksum"),
@@ -216,13 +192,7 @@ fn nmea_logs_are_read_and_their_errors_named() {
     );
 
     let gap = data_dir().join("trial-gap.nmea");
-    let o = run(&[
-        "compare",
-        "--model",
-        p.to_str().unwrap(),
-        "--data",
-        gap.to_str().unwrap(),
-    ]);
+    let o = run_compare(p.to_str().unwrap(), gap.to_str().unwrap(), &[]);
     assert_eq!(code(&o), 2);
     assert!(
         stderr(&o).contains("gap of 3.50 s in ROT (rate of turn) after 12:00:03.50"),
@@ -256,17 +226,8 @@ fn nmea_logs_are_read_and_their_errors_named() {
     }
     let no_rot = d.join("no-rot.nmea");
     std::fs::write(&no_rot, log).unwrap();
-    let compare = |extra: &[&str]| {
-        let mut args = vec![
-            "compare",
-            "--model",
-            p.to_str().unwrap(),
-            "--data",
-            no_rot.to_str().unwrap(),
-        ];
-        args.extend_from_slice(extra);
-        run(&args)
-    };
+    let compare =
+        |extra: &[&str]| run_compare(p.to_str().unwrap(), no_rot.to_str().unwrap(), extra);
     let o = compare(&[]);
     assert_eq!(code(&o), 2);
     assert!(
@@ -289,13 +250,7 @@ fn model_and_data_must_agree() {
     let m = write_model(&d);
     let f = d.join("ts1.csv");
     std::fs::write(&f, csv_text(60, 1.0)).unwrap();
-    let o = run(&[
-        "compare",
-        "--model",
-        m.to_str().unwrap(),
-        "--data",
-        f.to_str().unwrap(),
-    ]);
+    let o = run_compare(m.to_str().unwrap(), f.to_str().unwrap(), &[]);
     assert_eq!(code(&o), 2);
     assert!(stderr(&o).contains("sampled every 1 s, the model every 0.5 s"));
     let bad_model = d.join("bad.json");
@@ -304,13 +259,7 @@ fn model_and_data_must_agree() {
         r#"{"n":2,"ts":0.5,"a":[1.0],"b":[0,0],"k":[0,0]}"#,
     )
     .unwrap();
-    let o = run(&[
-        "compare",
-        "--model",
-        bad_model.to_str().unwrap(),
-        "--data",
-        f.to_str().unwrap(),
-    ]);
+    let o = run_compare(bad_model.to_str().unwrap(), f.to_str().unwrap(), &[]);
     assert_eq!(code(&o), 2);
     assert!(stderr(&o).contains("bad.json"), "{}", stderr(&o));
 }
@@ -414,13 +363,7 @@ fn implausible_or_still_records_are_refused_before_any_work() {
     let fits: Vec<String> = ["semi.csv", "comma.csv"]
         .iter()
         .map(|f| {
-            let o = run(&[
-                "compare",
-                "--model",
-                m.to_str().unwrap(),
-                "--data",
-                d.join(f).to_str().unwrap(),
-            ]);
+            let o = run_compare(m.to_str().unwrap(), d.join(f).to_str().unwrap(), &[]);
             assert_eq!(code(&o), 0, "{f}: {}", stderr(&o));
             stdout(&o)
                 .lines()
@@ -509,13 +452,7 @@ fn json_models_pass_the_checks_a_blob_gets() {
     ] {
         let m = d.join(name);
         std::fs::write(&m, text).unwrap();
-        let o = run(&[
-            "compare",
-            "--model",
-            m.to_str().unwrap(),
-            "--data",
-            f.to_str().unwrap(),
-        ]);
+        let o = run_compare(m.to_str().unwrap(), f.to_str().unwrap(), &[]);
         assert_eq!(code(&o), 2, "{name}: {}", stderr(&o));
         assert!(stderr(&o).contains(name), "{name}: {}", stderr(&o));
         assert!(stdout(&o).is_empty(), "{name}: {}", stdout(&o));
@@ -636,13 +573,7 @@ fn navigation_input_errors_name_row_and_column_and_jumps_are_counted() {
         }
         let p = d.join(name);
         std::fs::write(&p, t).unwrap();
-        let o = run(&[
-            "compare",
-            "--model",
-            m.to_str().unwrap(),
-            "--data",
-            p.to_str().unwrap(),
-        ]);
+        let o = run_compare(m.to_str().unwrap(), p.to_str().unwrap(), &[]);
         assert_eq!(code(&o), 2, "{name}: {}", stderr(&o));
         let first = stderr(&o).lines().next().unwrap_or_default().to_string();
         assert!(
@@ -670,13 +601,7 @@ fn split_cuts_a_log_at_its_gaps_and_clock_restarts_into_records_read_whole() {
     let header = &run1[0];
     let log = d.join("log.csv");
     std::fs::write(&log, format!("{header}\n{}\n", rows.join("\n"))).unwrap();
-    let o = run(&[
-        "compare",
-        "--model",
-        m.to_str().unwrap(),
-        "--data",
-        log.to_str().unwrap(),
-    ]);
+    let o = run_compare(m.to_str().unwrap(), log.to_str().unwrap(), &[]);
     assert_eq!(code(&o), 2);
     assert!(
         stderr(&o).contains("row 201") && stderr(&o).contains("yawcast split"),
@@ -710,13 +635,7 @@ fn split_cuts_a_log_at_its_gaps_and_clock_restarts_into_records_read_whole() {
     assert!(!out.join("log_4.csv").exists());
     for k in 1..=3 {
         let p = out.join(format!("log_{k}.csv"));
-        let o = run(&[
-            "compare",
-            "--model",
-            m.to_str().unwrap(),
-            "--data",
-            p.to_str().unwrap(),
-        ]);
+        let o = run_compare(m.to_str().unwrap(), p.to_str().unwrap(), &[]);
         assert_eq!(code(&o), 0, "piece {k}: {}", stderr(&o));
     }
     // the summary's field names are a contract
