@@ -24,15 +24,17 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "SHIP.toml")]
     pub ship: Option<PathBuf>,
     /// Simulator: `lng` (the built-in 1:24 LNG carrier, pods, Ts 1 s), `kvlcc2` (the KVLCC2
-    /// tanker by the MMG standard method, full scale L_pp 320 m, Ts 1 s) or `mariner` (the
-    /// Mariner cargo ship, Abkowitz-type, L_pp 160.93 m, Ts 1 s). The new worlds add a
+    /// tanker by the MMG standard method, full scale L_pp 320 m, Ts 1 s), `mariner` (the
+    /// Mariner cargo ship, Abkowitz-type, L_pp 160.93 m, Ts 1 s) or `seiun-maru` (the Seiun
+    /// Maru, a fine 105 m training ship by the MMG standard method, Ts 1 s). The new worlds add a
     /// background yaw disturbance, gyro and compass errors and, with `--effect wind`, gusts;
     /// their `--effect`s are the built-in ship's carried over to the hull, their `prbs`
     /// holds stretched by the hull's L/U.
     #[arg(long, value_name = "NAME", default_value = "lng")]
     pub world: String,
-    /// Length between perpendiculars (m) of a Froude-scaled `--world kvlcc2` (speeds and
-    /// times by √(L/320); the default Ts too).
+    /// Length between perpendiculars (m) of a Froude-scaled `--world kvlcc2` or
+    /// `seiun-maru` (speeds and times by √(L/L_full), L_full 320 or 105 m; the default Ts
+    /// too).
     #[arg(long, value_name = "L_M")]
     pub scale: Option<f64>,
     /// Switch on a library effect, by its name (docs/formats.md; a wrong name lists them),
@@ -45,7 +47,7 @@ pub struct SimulateArgs {
     /// Record length (s).
     #[arg(long, value_name = "S", default_value_t = 1800.0)]
     pub duration: f64,
-    /// Sample time (s); default 1, on a scaled kvlcc2 √(L/320).
+    /// Sample time (s); default 1, on a scaled kvlcc2 or seiun-maru √(L/L_full).
     #[arg(long, value_name = "S")]
     pub ts: Option<f64>,
     /// Command: `prbs` (identification input, random switching, 5–20°), `zigzag:10/10`,

@@ -7,8 +7,11 @@
 //!   Yoshimura 2015), full scale (`L_pp` 320 m) or Froude-scaled to any `L_pp`.
 //! - [`WorldKind::Mariner`]: the Mariner-class cargo ship, an Abkowitz-type model
 //!   (Chislett & Strøm-Tejsen 1965), full scale (`L_pp` 160.93 m).
+//! - [`WorldKind::SeiunMaru`]: the Seiun Maru, a 105 m training ship with a fine hull, by
+//!   the MMG standard method (Yoshimura & Masumoto 2012), full scale or Froude-scaled. It
+//!   was added after the diagnosis's rules were set, to check them on a hull they never saw.
 //!
-//! The two new worlds share one environment and one integrator:
+//! The new worlds share one environment and one integrator:
 //!
 //! - **State** `[u, v, r, x_N, y_E, ψ]` with `u, v` the velocity *through the water* in body
 //!   axes. A current is uniform and steady in the earth frame, so the water is an inertial
@@ -61,7 +64,9 @@ use crate::io::data::Record;
 pub(crate) mod env;
 mod kvlcc2;
 mod mariner;
+mod mmg;
 mod oracle;
+mod seiun;
 mod timed;
 
 use env::{gauss_markov, quantise, Sensors, Windage};
@@ -93,13 +98,21 @@ pub enum WorldKind {
     Kvlcc2,
     /// The Mariner-class cargo ship, Abkowitz-type (Chislett & Strøm-Tejsen 1965).
     Mariner,
+    /// The Seiun Maru, a fine 105 m training ship, by the MMG standard method (Yoshimura &
+    /// Masumoto 2012).
+    SeiunMaru,
 }
 
 impl WorldKind {
     /// Every world, the built-in one first.
-    pub const ALL: [WorldKind; 3] = [WorldKind::Lng, WorldKind::Kvlcc2, WorldKind::Mariner];
+    pub const ALL: [WorldKind; 4] = [
+        WorldKind::Lng,
+        WorldKind::Kvlcc2,
+        WorldKind::Mariner,
+        WorldKind::SeiunMaru,
+    ];
 
-    /// The stable name (`lng`, `kvlcc2`, `mariner`).
+    /// The stable name (`lng`, `kvlcc2`, `mariner`, `seiun-maru`).
     ///
     /// ```
     /// use yawcast::sim::WorldKind;
@@ -111,6 +124,7 @@ impl WorldKind {
             WorldKind::Lng => "lng",
             WorldKind::Kvlcc2 => "kvlcc2",
             WorldKind::Mariner => "mariner",
+            WorldKind::SeiunMaru => "seiun-maru",
         }
     }
 
@@ -172,19 +186,20 @@ pub struct World {
 }
 
 impl World {
-    /// The world `kind`, at `L_pp = scale_lpp` metres when given (KVLCC2 only: the
-    /// built-in ship is a model already, the Mariner model is full scale only).
+    /// The world `kind`, at `L_pp = scale_lpp` metres when given (the MMG hulls, KVLCC2 and
+    /// the Seiun Maru, only: the built-in ship is a model already, the Mariner model is full
+    /// scale only).
     ///
     /// # Errors
     /// [`SimError::Invalid`] (`world.scale`) for a scale on another world or outside
     /// 1–1000 m.
     pub fn new(kind: WorldKind, scale_lpp: Option<f64>) -> Result<World, SimError> {
         if let Some(l) = scale_lpp {
-            if kind != WorldKind::Kvlcc2 {
+            if !matches!(kind, WorldKind::Kvlcc2 | WorldKind::SeiunMaru) {
                 return Err(SimError::invalid(
                     "world.scale",
                     l,
-                    "no scale: only kvlcc2 takes one",
+                    "no scale: only kvlcc2 and seiun-maru take one",
                 ));
             }
             super::ship::within("world.scale", l, 1.0, 1000.0)?;
@@ -203,10 +218,15 @@ impl World {
     fn hull(&self) -> Option<Box<dyn Hull>> {
         match self.kind {
             WorldKind::Lng => None,
-            WorldKind::Kvlcc2 => Some(Box::new(kvlcc2::Kvlcc2::new(
+            WorldKind::Kvlcc2 => Some(Box::new(mmg::Mmg::new(
+                &kvlcc2::KVLCC2,
                 self.lpp.unwrap_or(kvlcc2::LPP_FULL),
             ))),
             WorldKind::Mariner => Some(Box::new(mariner::Mariner::new())),
+            WorldKind::SeiunMaru => Some(Box::new(mmg::Mmg::new(
+                &seiun::SEIUN_MARU,
+                self.lpp.unwrap_or(seiun::LPP_FULL),
+            ))),
         }
     }
 

@@ -25,7 +25,7 @@ fn mean(v: &[f64]) -> f64 {
     v.iter().sum::<f64>() / v.len() as f64
 }
 
-const NEW: [WorldKind; 2] = [WorldKind::Kvlcc2, WorldKind::Mariner];
+const NEW: [WorldKind; 3] = [WorldKind::Kvlcc2, WorldKind::Mariner, WorldKind::SeiunMaru];
 
 #[test]
 fn the_lng_world_is_the_built_in_simulator() {
@@ -433,7 +433,7 @@ fn the_worlds_own_predictor_beats_a_linear_model_of_the_hull() {
 
 #[test]
 fn the_autopilot_keeps_every_hull_on_its_set_course() {
-    for kind in [WorldKind::Lng, WorldKind::Kvlcc2, WorldKind::Mariner] {
+    for kind in WorldKind::ALL {
         let w = World::new(kind, None).unwrap();
         let sc = Scenario {
             input: w.default_autopilot(),
