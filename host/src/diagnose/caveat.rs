@@ -15,6 +15,13 @@ use crate::io::data::Record;
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(tag = "caveat", rename_all = "kebab-case")]
 pub enum Caveat {
+    /// The model given is a plain linear model, and its reference records show a steady
+    /// offset (a yaw moment or a gyro offset) that `yawcast identify` would have added; the
+    /// statistics were measured against the reference model identified with it.
+    ReferenceOffset {
+        /// The sentence naming the offset and the rule that found it.
+        words: String,
+    },
     /// The reference records show steering-gear dynamics of their own; the statistics were
     /// measured against the reference model with them.
     ReferenceGear {
@@ -161,7 +168,9 @@ impl Caveat {
     /// ```
     pub fn explain(&self) -> String {
         match self {
-            Caveat::ReferenceGear { words } => words.trim().to_string(),
+            Caveat::ReferenceOffset { words } | Caveat::ReferenceGear { words } => {
+                words.trim().to_string()
+            }
             Caveat::Blocks {
                 trials,
                 reference,
@@ -341,6 +350,7 @@ impl Caveat {
 
 /// The caveats of a diagnosis, in the order the explanation gives them.
 pub(super) fn caveats(
+    offset_words: Option<&str>,
     gear_words: Option<&str>,
     records: [&[Record]; 3],
     windows: &[Option<Vec<Record>>; 3],
@@ -349,6 +359,9 @@ pub(super) fn caveats(
     ch: &Channels,
 ) -> Vec<Caveat> {
     let mut out = Vec::new();
+    if let Some(w) = offset_words {
+        out.push(Caveat::ReferenceOffset { words: w.into() });
+    }
     if let Some(w) = gear_words {
         out.push(Caveat::ReferenceGear { words: w.into() });
     }

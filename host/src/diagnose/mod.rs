@@ -128,7 +128,7 @@ use caveat::caveats;
 use channels::Channels;
 use evidence::{grid, reference_versions, trial_stats, Set};
 use null::bootstrap;
-use reference::{foreign, reference_actuator, reference_hull};
+use reference::{foreign, reference_actuator, reference_hull, reference_offset};
 use rule::{gain_before_statistic, outpredicted, yaw_before_speed};
 use verdict::{cfg_m, effect_evidence, frozen_gain, rank, ranked, split, verdict_words, Evidence};
 
@@ -357,6 +357,14 @@ pub fn diagnose(
     .map(|(full, w)| w.as_deref().unwrap_or(full));
     let bar = progress_bar(cfg, reps);
     let has_ref = !reference.is_empty();
+    // A plain model whose reference records show a steady offset (`reference_offset`): the
+    // diagnosis reads the model `identify` writes for them, as if it had been given.
+    let offset = if has_ref {
+        reference_offset(model, reference, cfg)
+    } else {
+        None
+    };
+    let model = offset.as_ref().map_or(model, |o| &o.model);
     // The reference's own actuator physics (module docs): the statistics are measured against
     // the reference model that carries it, `base`; `model` is what the user gave.
     bar.set_message("the reference's own steering gear");
@@ -524,6 +532,7 @@ pub fn diagnose(
     let (verdict_name, mut explanation, after, augment) =
         verdict_words(&ev, &ranking, verdict, has_ref, cfg.alpha, &before);
     let mut caveats = caveats(
+        offset.as_ref().map(|o| o.words.as_str()),
         gear.as_ref().map(|g| g.words.as_str()),
         given,
         &windows,

@@ -1,6 +1,6 @@
-//! What the reference records show of their own: the steering-gear dynamics the linear
-//! reference model has absorbed into its poles, and whether the model given looks
-//! identified from the reference records at all.
+//! What the reference records show of their own: a steady offset the model given lacks, the
+//! steering-gear dynamics the linear reference model has absorbed into its poles, and
+//! whether the model given looks identified from the reference records at all.
 
 use yawcast_shared::model::EffectKind;
 
@@ -12,6 +12,54 @@ use crate::identify::model::Model;
 use crate::identify::pem::{self, PemConfig};
 use crate::io::data::Record;
 use crate::stats::chi2_sf;
+
+/// A steady offset the reference records show and the plain model given lacks: the
+/// reference model `identify` writes for them (with the offset, θ re-identified), and the
+/// explanation's sentence.
+#[derive(Debug, Clone)]
+pub(super) struct RefOffset {
+    pub(super) model: Model,
+    pub(super) words: String,
+}
+
+/// The reference's own steady offset. A model without any effect (a plain linear model, as
+/// `pem::identify` gives) is identified again on the reference records by
+/// [`pem::offset::identify`], the rule `yawcast identify` applies; when that rule adds a
+/// steady yaw moment or a gyro offset, the reference carries one that the model given does
+/// not, and the trials' errors against that model hold it too. Measured against the model
+/// without it, a constant moment reads as whatever heading-dependent moment the trials'
+/// headings make of it (the Seiun Maru's effect-free trials: `wind` at p = 1.7·10⁻⁷, `none`
+/// against the model with the offset). So the statistics are measured against the model
+/// `identify` would have written. `None` when the model carries any effect (it is not a
+/// plain model, and re-identifying it would drop what it carries) or the rule adds none.
+pub(super) fn reference_offset(
+    model: &Model,
+    reference: &[Record],
+    cfg: &DiagnoseConfig,
+) -> Option<RefOffset> {
+    if !model.effects.is_empty() || reference.is_empty() {
+        return None;
+    }
+    let pc = PemConfig {
+        order: model.a.len(),
+        ..cfg.augment.pem.clone()
+    };
+    let (rep, choice) = pem::offset::identify(reference, &pc).ok()?;
+    let choice = choice?;
+    if !rep.model.is_stable() {
+        return None;
+    }
+    let words = format!(
+        " The model given is a plain linear model, and `yawcast identify` would have added a \
+         steady offset for its reference records: {}. Every statistic is measured against the \
+         model identified with it.",
+        choice.describe()
+    );
+    Some(RefOffset {
+        model: rep.model,
+        words,
+    })
+}
 
 /// The actuator physics the reference records show of their own: the reference model with
 /// it, θ re-identified on the reference, and the explanation's sentence.
