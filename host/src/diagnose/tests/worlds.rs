@@ -505,5 +505,7 @@ fn on_a_hull_nothing_was_chosen_on_the_hidden_effect_is_named_and_nothing_else()
             panic!("{:?}", d.caveats)
         };
         assert!(words.contains("steady yaw moment equal to -0.2"), "{words}");
+        let json = serde_json::to_value(&d.caveats[0]).unwrap();
+        assert_eq!(json["caveat"], "reference-offset");
     }
 }
