@@ -141,8 +141,38 @@ pub(super) fn effect_evidence(
             100.0 * super::separation::MIN_HEADING_SEPARATION
         ));
     }
+    if let Some(own) = model.effect(kind).filter(|own| quicker_gear(&best, own)) {
+        // the model carries this kind as the reference's own gear (an effect it was given
+        // with is not tested again): on the trials' commands the gear is approximated
+        // best by a quicker one, which no effect the trials lack makes it
+        ev.p_yaw = 1.0;
+        ev.p = 1.0;
+        ev.score = ev.score.min(0.0);
+        ev.words.push_str(&format!(
+            "; not counted: quicker than the reference's own ({}), and a missing effect only \
+             slows a gear — the linear model's stand-in for the gear differs on these commands",
+            crate::diagnose::augment::describe(own, ts)
+        ));
+    }
     add_channels(&mut ev, has_ref, cfg, ch);
     ev
+}
+
+/// Is `best` a quicker steering gear than `own`, the reference's own of the same kind: a
+/// faster slew limit, a shorter dead time? The library's gear effects only slow a gear, so
+/// on a model that carries the reference's own gear such an estimate is the linear model's
+/// stand-in for the gear fitted to other commands (the Seiun Maru's angle limit hidden: a
+/// slew limit of 5.2 °/s beside the reference's own 4.3 °/s), not an effect the trials lack.
+///
+/// ```text
+/// quicker_gear(RateLimit 5.2, RateLimit 4.3) = true; quicker_gear(DeadTime 1, DeadTime 2) = true
+/// ```
+pub(super) fn quicker_gear(best: &Effect, own: &Effect) -> bool {
+    match (best, own) {
+        (Effect::RateLimit { rate: b }, Effect::RateLimit { rate: o }) => b > o,
+        (Effect::DeadTime { samples: b }, Effect::DeadTime { samples: o }) => b < o,
+        _ => false,
+    }
 }
 
 /// The yaw channel's evidence of `ev.best` in words (`pct`: the share of the error energy
@@ -641,6 +671,21 @@ pub fn effect_phrase(kind: EffectKind) -> &'static str {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn only_a_slower_gear_than_the_references_own_is_an_effect() {
+        let rate = |r| Effect::RateLimit { rate: r };
+        let dead = |n| Effect::DeadTime { samples: n };
+        assert!(quicker_gear(&rate(5.153), &rate(4.257)));
+        assert!(!quicker_gear(&rate(1.6), &rate(3.2)));
+        assert!(!quicker_gear(&rate(3.2), &rate(3.2)));
+        assert!(quicker_gear(&dead(1), &dead(2)));
+        assert!(!quicker_gear(&dead(3), &dead(2)));
+        // other kinds, or a kind against another, have no direction
+        assert!(!quicker_gear(&rate(5.0), &dead(2)));
+        let bias = Effect::Bias { beta: 1.0 };
+        assert!(!quicker_gear(&bias, &Effect::Bias { beta: 0.5 }));
+    }
 
     #[test]
     fn a_grid_value_is_as_fine_as_the_gaps_to_its_neighbours() {
