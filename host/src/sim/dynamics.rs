@@ -242,24 +242,8 @@ impl Model {
         let vp = vr / uu;
         let rp = r * self.lpp / uu;
         let q = self.half_rho_ld * u2;
-        let v2 = vp * vp;
-        let r2 = rp * rp;
-        let xh = q * (-h.r0 + h.x_vv * v2 + h.x_vr * vp * rp + h.x_rr * r2 + h.x_vvvv * v2 * v2);
-        let yh = q
-            * (h.y_v * vp
-                + h.y_r * rp
-                + h.y_vvv * v2 * vp
-                + h.y_vvr * v2 * rp
-                + h.y_vrr * vp * r2
-                + h.y_rrr * r2 * rp);
-        let nh = q
-            * self.lpp
-            * (h.n_v * vp
-                + h.n_r * rp
-                + h.n_vvv * v2 * vp
-                + h.n_vvr * v2 * rp
-                + h.n_vrr * vp * r2
-                + h.n_rrr * r2 * rp);
+        let [xh, yh, nh] = h.forces(vp, rp);
+        let (xh, yh, nh) = (q * xh, q * yh, q * self.lpp * nh);
         // pods: vectored thrust plus the housings' lift in the local inflow
         let (t, up) = self.thrust(ur);
         let vlat = self.gamma_p * (vr + self.l_p * r);

@@ -90,6 +90,39 @@ pub struct HullCoefficients {
     pub n_rrr: f64,
 }
 
+impl HullCoefficients {
+    /// The hull's non-dimensional forces `(X'_H, Y'_H, N'_H)` at `v' = v/U`, `r' = rL/U`:
+    /// `X'_H = −R'_0 + X'_vv v'² + X'_vr v'r' + X'_rr r'² + X'_vvvv v'⁴`, `Y'_H` and `N'_H`
+    /// cubic in `v'` and `r'` (MMG). Times `½ρLdU²` (and `L` for `N`) they are forces.
+    ///
+    /// ```
+    /// let h = yawcast::sim::Ship::default_lng().hull;
+    /// let [x, y, n] = h.forces(0.0, 0.0);
+    /// assert_eq!((x, y, n), (-h.r0, 0.0, 0.0));
+    /// ```
+    #[inline]
+    pub fn forces(&self, vp: f64, rp: f64) -> [f64; 3] {
+        let h = self;
+        let v2 = vp * vp;
+        let r2 = rp * rp;
+        [
+            -h.r0 + h.x_vv * v2 + h.x_vr * vp * rp + h.x_rr * r2 + h.x_vvvv * v2 * v2,
+            h.y_v * vp
+                + h.y_r * rp
+                + h.y_vvv * v2 * vp
+                + h.y_vvr * v2 * rp
+                + h.y_vrr * vp * r2
+                + h.y_rrr * r2 * rp,
+            h.n_v * vp
+                + h.n_r * rp
+                + h.n_vvv * v2 * vp
+                + h.n_vvr * v2 * rp
+                + h.n_vrr * vp * r2
+                + h.n_rrr * r2 * rp,
+        ]
+    }
+}
+
 /// The azimuth pods (all pods together; they steer as one).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -170,17 +170,9 @@ mod tests {
     use super::*;
     use crate::sim::inputs::rng;
 
+    /// KVLCC2's full-scale windage.
     fn tanker() -> Windage {
-        Windage {
-            loa: 325.0,
-            a_l: 3600.0,
-            a_f: 1400.0,
-            s_l: -25.0,
-            cd_t: 0.70,
-            cd_l_bow: 0.90,
-            cd_l_stern: 0.55,
-            delta: 0.40,
-        }
+        super::super::kvlcc2::KVLCC2.windage
     }
 
     #[test]

@@ -21,6 +21,7 @@
 use super::env::Windage;
 use super::mmg::{Coeffs, Wake};
 use super::Gear;
+use crate::sim::HullCoefficients;
 
 /// Full-scale length between perpendiculars (m).
 pub(crate) const LPP_FULL: f64 = 320.0;
@@ -38,29 +39,31 @@ pub(crate) const KVLCC2: Coeffs = Coeffs {
     d_p: 9.86,
     h_r: 15.80,
     a_r: 112.5,
-    // Added masses (Table 2).
-    m_x: 0.022,
-    m_y: 0.223,
-    j_z: 0.011,
+    hull: HullCoefficients {
+        // Added masses (Table 2).
+        m_x: 0.022,
+        m_y: 0.223,
+        j_z: 0.011,
+        // Hull resistance and derivatives (Table 3).
+        r0: 0.022,
+        x_vv: -0.040,
+        x_vr: 0.002,
+        x_rr: 0.011,
+        x_vvvv: 0.771,
+        y_v: -0.315,
+        y_r: 0.083,
+        y_vvv: -1.607,
+        y_vvr: 0.379,
+        y_vrr: -0.391,
+        y_rrr: 0.008,
+        n_v: -0.137,
+        n_r: -0.049,
+        n_vvv: -0.030,
+        n_vvr: -0.294,
+        n_vrr: 0.055,
+        n_rrr: -0.013,
+    },
     k_zz: 0.25,
-    // Hull resistance and derivatives (Table 3).
-    r0: 0.022,
-    x_vv: -0.040,
-    x_vr: 0.002,
-    x_rr: 0.011,
-    x_vvvv: 0.771,
-    y_v: -0.315,
-    y_r: 0.083,
-    y_vvv: -1.607,
-    y_vvr: 0.379,
-    y_vrr: -0.391,
-    y_rrr: 0.008,
-    n_v: -0.137,
-    n_r: -0.049,
-    n_vvv: -0.030,
-    n_vvr: -0.294,
-    n_vrr: 0.055,
-    n_rrr: -0.013,
     // Propeller (Table 2).
     t_p: 0.220,
     w_p0: 0.40,

@@ -21,6 +21,7 @@
 
 use super::env::Windage;
 use super::{Gear, Hull};
+use crate::sim::HullCoefficients;
 
 const G: f64 = 9.81;
 
@@ -57,32 +58,10 @@ pub(crate) struct Coeffs {
     pub h_r: f64,
     /// Rudder area (m²).
     pub a_r: f64,
-    /// Added masses `m'_x`, `m'_y` and added moment `J'_z`.
-    pub m_x: f64,
-    pub m_y: f64,
-    pub j_z: f64,
+    /// Added masses, resistance and the hull's derivatives (non-dimensional).
+    pub hull: HullCoefficients,
     /// Yaw radius of gyration over `L_pp`.
     pub k_zz: f64,
-    /// Resistance `R'_0` and the hull's surge derivatives.
-    pub r0: f64,
-    pub x_vv: f64,
-    pub x_vr: f64,
-    pub x_rr: f64,
-    pub x_vvvv: f64,
-    /// Sway derivatives.
-    pub y_v: f64,
-    pub y_r: f64,
-    pub y_vvv: f64,
-    pub y_vvr: f64,
-    pub y_vrr: f64,
-    pub y_rrr: f64,
-    /// Yaw derivatives.
-    pub n_v: f64,
-    pub n_r: f64,
-    pub n_vvv: f64,
-    pub n_vvr: f64,
-    pub n_vrr: f64,
-    pub n_rrr: f64,
     /// Thrust deduction `t_P` and straight-ahead wake `w_P0`.
     pub t_p: f64,
     pub w_p0: f64,
@@ -142,9 +121,9 @@ impl Mmg {
         let h_r = c.h_r / lambda;
         let half_rho_l2d = 0.5 * c.rho * lpp * lpp * d;
         let m = c.rho * c.nabla / lambda.powi(3);
-        let mx = c.m_x * half_rho_l2d;
-        let my = c.m_y * half_rho_l2d;
-        let jz = c.j_z * half_rho_l2d * lpp * lpp;
+        let mx = c.hull.m_x * half_rho_l2d;
+        let my = c.hull.m_y * half_rho_l2d;
+        let jz = c.hull.j_z * half_rho_l2d * lpp * lpp;
         let xg = c.x_g / lambda;
         let izg = m * (c.k_zz * lpp).powi(2);
         let a11 = m + my;
@@ -184,7 +163,7 @@ impl Mmg {
     /// straight course at `u` (bisection).
     fn revolutions_for(&self, u: f64) -> f64 {
         let c = self.c;
-        let resist = c.r0 * 0.5 * c.rho * self.lpp * self.d * u * u;
+        let resist = c.hull.r0 * 0.5 * c.rho * self.lpp * self.d * u * u;
         let net = |n: f64| {
             let j = u * (1.0 - c.w_p0) / (n * self.d_p);
             let kt = self.thrust_coefficient(j);
@@ -276,23 +255,8 @@ impl Hull for Mmg {
         let vp = v / uu;
         let rp = r * l / uu;
         let q = 0.5 * c.rho * l * self.d * u2;
-        let (v2, r2) = (vp * vp, rp * rp);
-        let xh = q * (-c.r0 + c.x_vv * v2 + c.x_vr * vp * rp + c.x_rr * r2 + c.x_vvvv * v2 * v2);
-        let yh = q
-            * (c.y_v * vp
-                + c.y_r * rp
-                + c.y_vvv * v2 * vp
-                + c.y_vvr * v2 * rp
-                + c.y_vrr * vp * r2
-                + c.y_rrr * r2 * rp);
-        let nh = q
-            * l
-            * (c.n_v * vp
-                + c.n_r * rp
-                + c.n_vvv * v2 * vp
-                + c.n_vvr * v2 * rp
-                + c.n_vrr * vp * r2
-                + c.n_rrr * r2 * rp);
+        let [xh, yh, nh] = c.hull.forces(vp, rp);
+        let (xh, yh, nh) = (q * xh, q * yh, q * l * nh);
         // propeller
         let beta = (-v).atan2(u);
         let beta_p = beta - c.x_p * rp;
