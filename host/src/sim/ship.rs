@@ -107,20 +107,19 @@ impl HullCoefficients {
         let r2 = rp * rp;
         [
             -h.r0 + h.x_vv * v2 + h.x_vr * vp * rp + h.x_rr * r2 + h.x_vvvv * v2 * v2,
-            h.y_v * vp
-                + h.y_r * rp
-                + h.y_vvv * v2 * vp
-                + h.y_vvr * v2 * rp
-                + h.y_vrr * vp * r2
-                + h.y_rrr * r2 * rp,
-            h.n_v * vp
-                + h.n_r * rp
-                + h.n_vvv * v2 * vp
-                + h.n_vvr * v2 * rp
-                + h.n_vrr * vp * r2
-                + h.n_rrr * r2 * rp,
+            cubic([h.y_v, h.y_r, h.y_vvv, h.y_vvr, h.y_vrr, h.y_rrr], vp, rp),
+            cubic([h.n_v, h.n_r, h.n_vvv, h.n_vvr, h.n_vrr, h.n_rrr], vp, rp),
         ]
     }
+}
+
+/// `a_v v' + a_r r' + a_vvv v'²v' + a_vvr v'²r' + a_vrr v'r'² + a_rrr r'²r'`, the MMG sway
+/// force's and yaw moment's polynomial, summed in that order.
+#[inline]
+fn cubic([a_v, a_r, a_vvv, a_vvr, a_vrr, a_rrr]: [f64; 6], vp: f64, rp: f64) -> f64 {
+    let v2 = vp * vp;
+    let r2 = rp * rp;
+    a_v * vp + a_r * rp + a_vvv * v2 * vp + a_vvr * v2 * rp + a_vrr * vp * r2 + a_rrr * r2 * rp
 }
 
 /// The azimuth pods (all pods together; they steer as one).
