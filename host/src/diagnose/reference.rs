@@ -13,11 +13,11 @@ use crate::identify::pem::{self, PemConfig};
 use crate::io::data::Record;
 use crate::stats::chi2_sf;
 
-/// A steady offset the reference records show and the plain model given lacks: the
-/// reference model `identify` writes for them (with the offset, θ re-identified), and the
-/// explanation's sentence.
+/// What the reference records show of their own and the model given lacks (a steady offset,
+/// steering-gear dynamics): the reference model with it, θ re-identified on the reference,
+/// and the explanation's sentence.
 #[derive(Debug, Clone)]
-pub(super) struct RefOffset {
+pub(super) struct RefOwn {
     pub(super) model: Model,
     pub(super) words: String,
 }
@@ -36,7 +36,7 @@ pub(super) fn reference_offset(
     model: &Model,
     reference: &[Record],
     cfg: &DiagnoseConfig,
-) -> Option<RefOffset> {
+) -> Option<RefOwn> {
     if !model.effects.is_empty() || reference.is_empty() {
         return None;
     }
@@ -55,18 +55,10 @@ pub(super) fn reference_offset(
          model identified with it.",
         choice.describe()
     );
-    Some(RefOffset {
+    Some(RefOwn {
         model: rep.model,
         words,
     })
-}
-
-/// The actuator physics the reference records show of their own: the reference model with
-/// it, θ re-identified on the reference, and the explanation's sentence.
-#[derive(Debug, Clone)]
-pub(super) struct RefActuator {
-    pub(super) model: Model,
-    pub(super) words: String,
 }
 
 /// The reference's own steering-gear physics (module docs): forward selection over the
@@ -78,7 +70,7 @@ pub(super) fn reference_actuator(
     model: &Model,
     reference: &[Record],
     cfg: &DiagnoseConfig,
-) -> Option<RefActuator> {
+) -> Option<RefOwn> {
     let kinds: Vec<EffectKind> = EffectKind::ALL
         .iter()
         .copied()
@@ -122,7 +114,7 @@ pub(super) fn reference_actuator(
         without,
         with,
     );
-    Some(RefActuator {
+    Some(RefOwn {
         model: f.model,
         words,
     })
