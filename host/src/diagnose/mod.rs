@@ -366,7 +366,8 @@ pub fn diagnose(
     };
     let model = offset.as_ref().map_or(model, |o| &o.model);
     // The reference's own actuator physics (module docs): the statistics are measured against
-    // the reference model that carries it, `base`; `model` is what the user gave.
+    // the reference model that carries it, `base`; `model` is what the user gave (a plain
+    // model with the reference's own offset added, above).
     bar.set_message("the reference's own steering gear");
     let gear = if has_ref {
         reference_actuator(model, reference, cfg)
