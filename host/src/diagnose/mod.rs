@@ -458,7 +458,11 @@ pub fn diagnose(
         .enumerate()
         .map(|(i, &kind)| {
             let mut e = effect_evidence(base, kind, &real[i], &nulls[i], has_ref, cfg, &ch);
-            if let Some(own) = base.effect(kind).filter(|_| gear.is_some()) {
+            // (a quicker estimate's own words name the reference's gear already)
+            if let Some(own) = base
+                .effect(kind)
+                .filter(|own| gear.is_some() && !verdict::quicker_gear(&e.best, own))
+            {
                 e.words.push_str(&format!(
                     " (the reference's own: {})",
                     crate::diagnose::augment::describe(own, model.ts)
