@@ -25,11 +25,11 @@ pub use checks::{
     check_uniform, unit_warnings, unwrap_degrees, validate_record, Limits, MIN_COMMAND_SPAN_DEG,
     MIN_RATE_SPAN_DEGPS, MIN_TURN_DEG, RUDDER_MAX_DEG,
 };
-pub(crate) use csv_file::Dialect;
 pub use csv_file::{
     csv_text, decode_text, fill_gaps, heading_rate, parse_csv, read_csv, read_csv_with, resample,
     write_csv, Columns,
 };
+pub(crate) use csv_file::{uniform_grid, Dialect};
 pub use heading::{block_mean, heading_bias, HeadingBias};
 pub use split::{split_at_gaps, Break, BreakKind, Piece, Split};
 pub(crate) use timestamp::days_from_civil;

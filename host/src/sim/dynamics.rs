@@ -165,19 +165,12 @@ impl Model {
             s[0] = u;
             self.forces(&s, 0.0, 1.0, Self::calm()).0
         };
-        let (mut lo, mut hi) = (1e-3, 30.0);
+        let (lo, hi) = (1e-3, 30.0);
         if net(lo) <= 0.0 || net(hi) >= 0.0 {
             return None;
         }
-        for _ in 0..80 {
-            let mid = 0.5 * (lo + hi);
-            if net(mid) > 0.0 {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        Some(0.5 * (lo + hi))
+        // Past the equilibrium the thrust no longer exceeds the resistance.
+        Some(super::bisect(lo, hi, 80, |u| net(u) <= 0.0))
     }
 
     fn calm() -> Env {

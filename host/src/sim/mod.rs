@@ -503,6 +503,27 @@ fn simulate_full(
     Ok((rec, nav, truth))
 }
 
+/// The root of a function that changes sign once in `[lo, hi]`, by `iterations` halvings:
+/// `past(x)` says whether `x` lies beyond the root (above it). The midpoint of the last
+/// bracket is returned. The hulls use it for an equilibrium speed and for the propeller
+/// revolutions of a speed.
+pub(crate) fn bisect(
+    mut lo: f64,
+    mut hi: f64,
+    iterations: usize,
+    past: impl Fn(f64) -> bool,
+) -> f64 {
+    for _ in 0..iterations {
+        let mid = 0.5 * (lo + hi);
+        if past(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
 fn push(v: &mut Option<Vec<f64>>, x: f64) {
     if let Some(v) = v.as_mut() {
         v.push(x);

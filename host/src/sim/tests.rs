@@ -147,3 +147,16 @@ fn bad_scenarios_name_the_field() {
     .unwrap_err();
     assert!(e.to_string().contains("limit_deg"), "{e}");
 }
+
+#[test]
+fn bisection_finds_a_root_from_either_side_and_keeps_the_last_bracket() {
+    // √2 as the root of x² − 2, rising through it.
+    let r = bisect(0.0, 2.0, 60, |x| x * x - 2.0 > 0.0);
+    assert!((r - 2f64.sqrt()).abs() < 1e-15, "{r}");
+    // A falling function: past the root it is no longer positive.
+    let f = |x: f64| 3.0 - x;
+    let r = bisect(0.0, 10.0, 60, |x| f(x) <= 0.0);
+    assert!((r - 3.0).abs() < 1e-14, "{r}");
+    // One halving leaves the midpoint of the half that holds the root.
+    assert_eq!(bisect(0.0, 8.0, 1, |x| x > 1.0).to_bits(), 2f64.to_bits());
+}

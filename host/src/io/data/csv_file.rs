@@ -413,7 +413,8 @@ pub fn resample(rec: &Record, dt: f64, path: &Path) -> Result<Record, DataError>
         });
     }
     let (t0, t1) = (rec.t[0], rec.t[rec.t.len() - 1]);
-    let n = ((t1 - t0) / dt + 1e-9).floor() as usize + 1;
+    let grid = uniform_grid(t0, t1, dt);
+    let n = grid.len();
     if n < 2 {
         return Err(DataError::TooShort {
             path: path.to_path_buf(),
@@ -421,7 +422,6 @@ pub fn resample(rec: &Record, dt: f64, path: &Path) -> Result<Record, DataError>
             needed: 2,
         });
     }
-    let grid: Vec<f64> = (0..n).map(|k| t0 + k as f64 * dt).collect();
     // For each grid time, the logged interval [t_j, t_{j+1}) that holds it and where in it.
     let mut at = Vec::with_capacity(n);
     let mut j = 0;
@@ -601,4 +601,33 @@ pub fn csv_text(rec: &Record) -> String {
         out.push('\n');
     }
     out
+}
+
+/// The uniform grid `t0, t0 + ts, …` up to `t1` (inclusive, to within 10⁻⁹ of a period), on
+/// which a record logged at uneven times is resampled: empty when `t1 < t0`. The CSV and NMEA
+/// readers both resample onto it, and each refuses a grid of fewer than 2 times with its own
+/// error.
+pub(crate) fn uniform_grid(t0: f64, t1: f64, ts: f64) -> Vec<f64> {
+    if t1 < t0 {
+        return Vec::new();
+    }
+    let n = ((t1 - t0) / ts + 1e-9).floor() as usize + 1;
+    (0..n).map(|k| t0 + k as f64 * ts).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::uniform_grid;
+
+    #[test]
+    fn the_grid_reaches_the_last_time_to_within_a_rounding_and_no_further() {
+        // 0.3 / 0.1 is 2.999…96 in binary: the last time still counts.
+        let g = uniform_grid(0.0, 0.3, 0.1);
+        assert_eq!(g.len(), 4);
+        assert_eq!(g[3].to_bits(), (3.0f64 * 0.1).to_bits());
+        // A time short of the next grid point by more than a rounding does not.
+        assert_eq!(uniform_grid(10.0, 10.299, 0.1).len(), 3);
+        assert_eq!(uniform_grid(5.0, 5.0, 1.0), vec![5.0]);
+        assert!(uniform_grid(2.0, 1.0, 1.0).is_empty());
+    }
 }

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use super::{hms, Chan, NmeaError, NmeaOptions, Series};
-use crate::io::data::Record;
+use crate::io::data::{uniform_grid, Record};
 
 /// The median positive spacing of a channel's samples (s).
 pub(super) fn median_step(v: &[(f64, f64, usize)]) -> f64 {
@@ -114,11 +114,8 @@ pub(super) fn resample(
             }
         }
     }
-    let n = if t_end >= t_start {
-        ((t_end - t_start) / ts + 1e-9).floor() as usize + 1
-    } else {
-        0
-    };
+    let grid = uniform_grid(t_start, t_end, ts);
+    let n = grid.len();
     if n < 2 {
         return Err(NmeaError::TooShort {
             path: path.to_path_buf(),
@@ -126,7 +123,6 @@ pub(super) fn resample(
             needed: 2,
         });
     }
-    let grid: Vec<f64> = (0..n).map(|i| t_start + i as f64 * ts).collect();
     let mut rec = Record {
         name: name.to_string(),
         ts,

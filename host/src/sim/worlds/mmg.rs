@@ -169,16 +169,8 @@ impl Mmg {
             let kt = self.thrust_coefficient(j);
             (1.0 - c.t_p) * c.rho * n * n * self.d_p.powi(4) * kt - resist
         };
-        let (mut lo, mut hi) = (1e-3, 1e3);
-        for _ in 0..200 {
-            let mid = 0.5 * (lo + hi);
-            if net(mid) > 0.0 {
-                hi = mid;
-            } else {
-                lo = mid;
-            }
-        }
-        0.5 * (lo + hi)
+        // Past the revolutions sought the thrust exceeds the resistance.
+        crate::sim::bisect(1e-3, 1e3, 200, |n| net(n) > 0.0)
     }
 
     /// Rudder forces `(X_R, Y_R, N_R)` at rudder angle δ (rad) given the inflow.
