@@ -79,6 +79,16 @@ pub enum Caveat {
         /// record's own offset and turn (under 0.005).
         separation: f64,
     },
+    /// A steady moment named (first or second) on trials that each hold one course, with
+    /// no anemometer: over one course a wind from one side turns the ship as a steady moment
+    /// does, and the yaw channel, which tells a moment varying with heading, cannot
+    /// (docs/method.md, "Records that each hold one course"). The records cannot tell a
+    /// steady moment from a wind.
+    BiasOrWind {
+        /// The share of the heading harmonics' variance the trials keep beyond each record's
+        /// own offset and turn (under 0.005).
+        separation: f64,
+    },
     /// An angle limit or a dead band named (first or second) on trials whose commands hold
     /// one magnitude — a zig-zag's ±20°: a limit below it and a dead band take the same off
     /// every command, and the records cannot tell them apart.
@@ -253,6 +263,16 @@ impl Caveat {
                  The records cannot tell a current from a wind; the anemometer's columns, or \
                  trials on several courses (a zig-zag or a PRBS on each of four headings), \
                  would.",
+                100.0 * separation
+            ),
+            Caveat::BiasOrWind { separation } => format!(
+                "The steady moment is named on trials that each hold one course (the heading \
+                 harmonics keep {:.2} % of their variance beyond each record's own offset and \
+                 turn) and no anemometer is logged: over one course a wind from one side \
+                 turns the ship as a steady moment does, and only a change of course would \
+                 change its moment. The records cannot tell a steady moment from a wind; the \
+                 anemometer's columns, or trials on several courses (a zig-zag or a PRBS on \
+                 each of four headings), would.",
                 100.0 * separation
             ),
             Caveat::ClipOrDeadBand {
@@ -448,6 +468,21 @@ pub(super) fn current_without_anemometer<'a>(
         })
 }
 
+/// The caveat for a steady moment named (`named`: the verdict's effect and its second) on
+/// trials whose [`super::separation::heading_separation`] (`separation`) is under
+/// [`super::separation::MIN_HEADING_SEPARATION`], with no anemometer logged
+/// ([`Caveat::BiasOrWind`]): the counterpart of [`Caveat::CurrentOrWind`] for the yaw
+/// channel. Where the anemometer is logged it measures the wind itself.
+pub(super) fn bias_or_wind(
+    named: &[EffectKind],
+    separation: Option<f64>,
+    anemometer: bool,
+) -> Option<Caveat> {
+    let s = separation.filter(|&s| s < super::separation::MIN_HEADING_SEPARATION)?;
+    (!anemometer && named.contains(&EffectKind::Bias))
+        .then_some(Caveat::BiasOrWind { separation: s })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -456,6 +491,28 @@ mod tests {
         (0..k)
             .map(|i| Record::from_uy(&format!("r{i}"), ts, vec![0.0; n], vec![0.0; n]))
             .collect()
+    }
+
+    #[test]
+    fn a_steady_moment_on_one_course_without_an_anemometer_may_be_a_wind() {
+        let bias = [EffectKind::RateLimit, EffectKind::Bias];
+        // an autopilot's or a zig-zag's one course, no anemometer: the caveat
+        let c = bias_or_wind(&bias, Some(0.0007), false).unwrap();
+        assert_eq!(c, Caveat::BiasOrWind { separation: 0.0007 });
+        assert!(
+            c.explain().contains("keep 0.07 % of their variance"),
+            "{}",
+            c.explain()
+        );
+        assert_eq!(serde_json::to_value(&c).unwrap()["caveat"], "bias-or-wind");
+        assert_eq!(serde_json::to_value(&c).unwrap()["separation"], 0.0007);
+        // the anemometer logged: it measures the wind itself
+        assert!(bias_or_wind(&bias, Some(0.0007), true).is_none());
+        // several courses (at the level or above), or no heading to judge: none
+        assert!(bias_or_wind(&bias, Some(0.005), false).is_none());
+        assert!(bias_or_wind(&bias, None, false).is_none());
+        // no steady moment named
+        assert!(bias_or_wind(&[EffectKind::Asymmetry], Some(0.0007), false).is_none());
     }
 
     #[test]

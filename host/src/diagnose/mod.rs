@@ -613,6 +613,11 @@ pub fn diagnose(
         .into_iter()
         .chain(then.as_ref().map(|(e, _)| e.kind))
         .collect();
+    caveats.extend(caveat::bias_or_wind(
+        &named,
+        ch.separation,
+        ch.anemometer.is_some(),
+    ));
     caveats.extend(commands::clip_or_dead_band(&named, est));
     caveats.extend(commands::asymmetry_or_bias(&named, est));
     caveats.extend(commands::slew_or_dead_time(&named, est));
