@@ -97,6 +97,12 @@ pub enum Caveat {
         magnitude_deg: f64,
         /// Share of the commanded samples (|δ| > 0) within 5 % of it.
         share: f64,
+        /// The held-out gains (pp, at 10 steps and in simulation) of the hull's nonlinear
+        /// damping, where it is significant, improves prediction and is not named: on
+        /// commands of one magnitude every swing turns about as fast, so a damping growing
+        /// with the rate takes about as much off each as a limit or a band does.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        damping_gains_pp: Option<[f64; 2]>,
     },
     /// A port/starboard asymmetry or a steady moment named (first or second) on trials whose
     /// commands hold one magnitude A: there an asymmetry is a steady moment and a changed
@@ -278,15 +284,26 @@ impl Caveat {
             Caveat::ClipOrDeadBand {
                 magnitude_deg,
                 share,
-            } => format!(
-                "The trials' commands hold one magnitude (±{magnitude_deg:.1}° in {:.0} % of \
-                 the commanded samples): an angle limit below it and a dead band take the same \
-                 off every such command and differ only in how the gear moves between them, \
-                 which the model approximates. The records cannot tell a saturation from a \
-                 dead band; commands of several magnitudes would (a PRBS, or zig-zags of two \
-                 amplitudes).",
-                100.0 * share
-            ),
+                damping_gains_pp,
+            } => {
+                let damping = damping_gains_pp.map_or(String::new(), |[g10, gsim]| {
+                    format!(
+                        " The hull's nonlinear damping is significant too (held-out {g10:+.1} \
+                         pp at 10 steps, {gsim:+.1} in simulation): every swing of one size \
+                         turns about as fast, so a damping growing with the rate takes about \
+                         as much off each; the records may not tell it from either."
+                    )
+                });
+                format!(
+                    "The trials' commands hold one magnitude (±{magnitude_deg:.1}° in {:.0} % \
+                     of the commanded samples): an angle limit below it and a dead band take \
+                     the same off every such command and differ only in how the gear moves \
+                     between them, which the model approximates. The records cannot tell a \
+                     saturation from a dead band; commands of several magnitudes would (a PRBS, \
+                     or zig-zags of two amplitudes).{damping}",
+                    100.0 * share
+                )
+            }
             Caveat::AsymmetryOrBias {
                 magnitude_deg,
                 share,

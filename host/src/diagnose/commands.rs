@@ -18,14 +18,21 @@ const ONE_MAGNITUDE_SHARE: f64 = 0.9;
 
 /// The caveat for an angle limit or a dead band named on commands of one magnitude
 /// ([`Caveat::ClipOrDeadBand`]): `named`, the verdict's effect and its second; `est`, the
-/// trials. The magnitude is the commonest |δ| to 0.1°, the share is over the samples whose
-/// command is not 0.
-pub(super) fn clip_or_dead_band(named: &[EffectKind], est: &[Record]) -> Option<Caveat> {
+/// trials; `damping`, the held-out gains (10 steps, simulation) of a significant nonlinear
+/// damping that improves prediction, when one is. The magnitude is the commonest |δ| to
+/// 0.1°, the share is over the samples whose command is not 0. The damping is said only
+/// where it is not named itself.
+pub(super) fn clip_or_dead_band(
+    named: &[EffectKind],
+    est: &[Record],
+    damping: Option<[f64; 2]>,
+) -> Option<Caveat> {
     let (magnitude_deg, share) =
         names_one_magnitude(named, EffectKind::Saturation, EffectKind::DeadBand, est)?;
     Some(Caveat::ClipOrDeadBand {
         magnitude_deg,
         share,
+        damping_gains_pp: damping.filter(|_| !named.contains(&EffectKind::NonlinearDamping)),
     })
 }
 
@@ -169,38 +176,64 @@ mod tests {
                 _ => -20.0,
             })
             .collect();
-        let c = clip_or_dead_band(&[EffectKind::DeadBand], &[rec(zz.clone())]).unwrap();
+        let c = clip_or_dead_band(&[EffectKind::DeadBand], &[rec(zz.clone())], None).unwrap();
         assert_eq!(
             c,
             Caveat::ClipOrDeadBand {
                 magnitude_deg: 20.0,
-                share: 1.0
+                share: 1.0,
+                damping_gains_pp: None,
             }
         );
         assert!(c.explain().contains("±20.0° in 100 %"), "{}", c.explain());
         let json = serde_json::to_value(&c).unwrap();
         assert_eq!(json["caveat"], "clip-or-dead-band");
         assert_eq!(json["magnitude_deg"], 20.0);
+        // a significant damping that predicts better beside it: said, with its gains
+        let c = clip_or_dead_band(
+            &[EffectKind::DeadBand],
+            &[rec(zz.clone())],
+            Some([12.3, 29.9]),
+        )
+        .unwrap();
+        assert!(
+            c.explain().contains("nonlinear damping is significant too (held-out +12.3 pp at 10 steps, +29.9 in simulation)"),
+            "{}",
+            c.explain()
+        );
+        assert_eq!(
+            serde_json::to_value(&c).unwrap()["damping_gains_pp"],
+            serde_json::json!([12.3, 29.9])
+        );
+        // … but not where the damping is named itself, nor in the JSON without one
+        let k = [EffectKind::NonlinearDamping, EffectKind::DeadBand];
+        let c = clip_or_dead_band(&k, &[rec(zz.clone())], Some([12.3, 29.9])).unwrap();
+        assert!(!c.explain().contains("damping"), "{}", c.explain());
+        assert!(serde_json::to_value(&c)
+            .unwrap()
+            .get("damping_gains_pp")
+            .is_none());
         // named second, the same
         let k = [EffectKind::Current, EffectKind::Saturation];
-        assert!(clip_or_dead_band(&k, &[rec(zz.clone())]).is_some());
+        assert!(clip_or_dead_band(&k, &[rec(zz.clone())], None).is_some());
         // neither named: none
-        assert!(clip_or_dead_band(&[EffectKind::DeadTime], &[rec(zz.clone())]).is_none());
+        assert!(clip_or_dead_band(&[EffectKind::DeadTime], &[rec(zz.clone())], None).is_none());
         // a PRBS of four magnitudes: a quarter at each, the records tell them apart
         let prbs: Vec<f64> = (0..392)
             .map(|i| [5.0, -10.0, 15.0, -20.0][(i / 7) % 4])
             .collect();
-        assert!(clip_or_dead_band(&[EffectKind::DeadBand], &[rec(prbs.clone())]).is_none());
+        assert!(clip_or_dead_band(&[EffectKind::DeadBand], &[rec(prbs.clone())], None).is_none());
         // 85 % at one magnitude: below the share, no caveat; 90 %: the caveat
         let mix =
             |k: usize| -> Vec<f64> { (0..100).map(|i| if i < k { 20.0 } else { 7.5 }).collect() };
-        assert!(clip_or_dead_band(&[EffectKind::DeadBand], &[rec(mix(85))]).is_none());
-        let c = clip_or_dead_band(&[EffectKind::DeadBand], &[rec(mix(90))]).unwrap();
+        assert!(clip_or_dead_band(&[EffectKind::DeadBand], &[rec(mix(85))], None).is_none());
+        let c = clip_or_dead_band(&[EffectKind::DeadBand], &[rec(mix(90))], None).unwrap();
         assert_eq!(
             c,
             Caveat::ClipOrDeadBand {
                 magnitude_deg: 20.0,
-                share: 0.9
+                share: 0.9,
+                damping_gains_pp: None,
             }
         );
         // an asymmetry and a steady moment on the same commands
@@ -270,10 +303,11 @@ mod tests {
                 side + if i % 5 == 0 { 0.6 } else { 0.0 }
             })
             .collect();
-        let c = clip_or_dead_band(&[EffectKind::DeadBand], &[rec(logged.clone())]).unwrap();
+        let c = clip_or_dead_band(&[EffectKind::DeadBand], &[rec(logged.clone())], None).unwrap();
         let Caveat::ClipOrDeadBand {
             magnitude_deg,
             share,
+            ..
         } = c
         else {
             panic!("{c:?}")
@@ -288,10 +322,11 @@ mod tests {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../tests/data/real/esso_osaka/zz20_n12_b.csv");
         let esso = crate::io::data::read_csv(&path).unwrap();
-        let c = clip_or_dead_band(&[EffectKind::Saturation], std::slice::from_ref(&esso));
+        let c = clip_or_dead_band(&[EffectKind::Saturation], std::slice::from_ref(&esso), None);
         let Some(Caveat::ClipOrDeadBand {
             magnitude_deg,
             share,
+            ..
         }) = c
         else {
             panic!("{c:?}")

@@ -618,7 +618,17 @@ pub fn diagnose(
         ch.separation,
         ch.anemometer.is_some(),
     ));
-    caveats.extend(commands::clip_or_dead_band(&named, est));
+    // a significant damping that predicts better beside an angle limit or a dead band named
+    // on one magnitude: the third look-alike there
+    let damping = ranking
+        .iter()
+        .find(|r| {
+            r.effect == EffectKind::NonlinearDamping.name()
+                && r.significant
+                && r.fit_gain_10_pp >= rule::NO_GAIN_PP
+        })
+        .map(|r| [r.fit_gain_10_pp, r.fit_gain_sim_pp]);
+    caveats.extend(commands::clip_or_dead_band(&named, est, damping));
     caveats.extend(commands::asymmetry_or_bias(&named, est));
     caveats.extend(commands::slew_or_dead_time(&named, est));
     caveats.extend(other);
