@@ -100,6 +100,7 @@ mod channels;
 mod commands;
 pub mod compare;
 mod evidence;
+mod gyro;
 mod null;
 mod reference;
 pub mod resid;
