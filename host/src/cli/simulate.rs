@@ -68,6 +68,11 @@ pub struct SimulateArgs {
     /// Initial heading (deg); drawn from the seed when not given.
     #[arg(long, value_name = "DEG")]
     pub heading: Option<f64>,
+    /// The background yaw disturbance times K (default 1: a first-order yaw moment whose
+    /// standard deviation is what 0.5° of rudder gives, time constant L_pp/U; 2 a rougher
+    /// day, 0 none). Only on the new worlds: the built-in ship has none.
+    #[arg(long, value_name = "K", default_value_t = 1.0)]
+    pub disturbance: f64,
     /// Log the apparent wind (anemometer) columns.
     #[arg(long)]
     pub log_wind: bool,
@@ -251,6 +256,18 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             )));
         }
     }
+    if !(args.disturbance.is_finite() && args.disturbance >= 0.0) {
+        return Err(bad(format!(
+            "--disturbance {}: expected a number ≥ 0 (1 is the world's own)",
+            args.disturbance
+        )));
+    }
+    if kind == WorldKind::Lng && args.disturbance != 1.0 {
+        return Err(bad(
+            "--disturbance: the built-in ship (--world lng) has no background yaw disturbance \
+             to scale; it is on the kvlcc2, mariner and seiun-maru worlds",
+        ));
+    }
     if args.out.is_none() && args.save_ship.is_none() {
         return Err(bad(
             "nothing to write: give --out FILE.csv (and/or --save-ship)",
@@ -274,6 +291,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         effects: effects.clone(),
         log_wind: args.log_wind,
         initial_heading_deg: args.heading,
+        disturbance: args.disturbance,
         ..Scenario::default()
     };
     scenario.validate().map_err(bad)?;

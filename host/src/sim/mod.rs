@@ -182,6 +182,11 @@ pub struct Scenario {
     pub warmup_s: f64,
     /// Largest internal integration step (s); default 0.1.
     pub dt_max: f64,
+    /// The background yaw disturbance of the simulator worlds ([`World`]) times this
+    /// (default 1: a standard deviation of what 0.5° of rudder gives; 2 a rougher day, 0
+    /// none). The built-in ship has no background disturbance and refuses any other value
+    /// than 1.
+    pub disturbance: f64,
 }
 
 impl Default for Scenario {
@@ -197,6 +202,7 @@ impl Default for Scenario {
             initial_heading_deg: None,
             warmup_s: 120.0,
             dt_max: 0.1,
+            disturbance: 1.0,
         }
     }
 }
@@ -244,6 +250,7 @@ impl Scenario {
         }
         ship::within("scenario.warmup_s", self.warmup_s, 0.0, 36_000.0)?;
         ship::within("scenario.dt_max", self.dt_max, 1e-4, 1.0)?;
+        ship::within("scenario.disturbance", self.disturbance, 0.0, 100.0)?;
         Ok(())
     }
 }
@@ -401,6 +408,13 @@ fn simulate_full(
 ) -> Result<(Record, SimNav, Vec<f64>), SimError> {
     ship.validate()?;
     scenario.validate()?;
+    if scenario.disturbance != 1.0 {
+        return Err(SimError::invalid(
+            "scenario.disturbance",
+            scenario.disturbance,
+            "1: the built-in ship has no background yaw disturbance to scale",
+        ));
+    }
     let effects = merged_effects(ship, &scenario.effects);
     let n = scenario.n_samples;
     let ts = scenario.ts;

@@ -665,7 +665,7 @@ fn simulate_hull(
         n,
         ts,
         tau_bg,
-        BACKGROUND_RUDDER_DEG.abs() * rudder_moment(hull, 1.0).abs(),
+        scenario.disturbance * BACKGROUND_RUDDER_DEG.abs() * rudder_moment(hull, 1.0).abs(),
     );
     let gust_std = if phys.wind_ne == (0.0, 0.0) {
         0.0

@@ -131,6 +131,42 @@ fn the_seed_fixes_the_record_and_the_background_is_always_there() {
 }
 
 #[test]
+fn the_background_disturbance_scales_with_the_scenario() {
+    // the same commands (their own stream) with the background disturbance off, as it is,
+    // and doubled: what it adds to the yaw rate doubles (the hull nearly linear at its
+    // size), off it adds nothing, and the world's own scale is the default record
+    let rms = |a: &[f64], b: &[f64]| {
+        (a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / a.len() as f64).sqrt()
+    };
+    for kind in NEW {
+        let w = World::new(kind, None).unwrap();
+        let at = |k: f64| {
+            let sc = Scenario {
+                disturbance: k,
+                ..quiet(1200, Vec::new(), &w)
+            };
+            w.simulate(&sc, 21).unwrap()
+        };
+        let (none, one, two) = (at(0.0), at(1.0), at(2.0));
+        assert_eq!(one, w.simulate(&quiet(1200, Vec::new(), &w), 21).unwrap());
+        assert_eq!(none.u, two.u);
+        let (a, b) = (rms(&one.y, &none.y), rms(&two.y, &none.y));
+        println!(
+            "{}: the background adds {a:.4} °/s, doubled {b:.4}",
+            kind.name()
+        );
+        assert!(a > 1e-3, "{a}");
+        assert!((b / a - 2.0).abs() < 0.3, "{a} {b}");
+    }
+    let lng = Scenario {
+        disturbance: 2.0,
+        ..Scenario::default()
+    };
+    let err = crate::sim::simulate(&Ship::default_lng(), &lng, 1).unwrap_err();
+    assert!(err.to_string().contains("disturbance"), "{err}");
+}
+
+#[test]
 fn every_effect_changes_what_it_should() {
     for kind in NEW {
         let w = World::new(kind, None).unwrap();
