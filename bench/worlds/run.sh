@@ -6,7 +6,7 @@
 #                       [--strengths LIST] [--effects LIST] [--jobs J] [--log-wind]
 #                       [--augment] [--won-back] [--trial-input KIND] [--ref-input KIND]
 #                       [--ts S] [--noise-scale K] [--duration S]
-#                       [--trial-disturbance K] [--ref-disturbance K]
+#                       [--trial-disturbance K] [--ref-disturbance K] [--ref-effect NAME]
 #
 #   --yawcast PATH    the binary (default: build the ci profile and use it)
 #   --work DIR        records, models and diagnoses (default target/bench-worlds)
@@ -50,6 +50,9 @@
 #                     record) times K (`simulate --disturbance`; default 1; 2 a rougher day
 #                     than the reference's); not on the built-in ship, which has none
 #   --ref-disturbance K  the same for the reference records
+#   --ref-effect NAME the reference records sailed with a library effect at full strength
+#                     (`simulate --effect`; e.g. wind: a reference sailed on a windy day,
+#                     the trials in whatever the case hides)
 #
 # Per world: the reference is 3 records of the world's identification input (seeds 900–902,
 # gyro noise 0.02 °/s, heading noise 0.1°) and the model identified on them; each case is 3
@@ -82,6 +85,7 @@ noisescale=1
 duration=""
 trialdist=""
 refdist=""
+refeffect=""
 while [ $# -gt 0 ]; do
     case "$1" in
         --yawcast) yawcast="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
@@ -101,7 +105,8 @@ while [ $# -gt 0 ]; do
         --duration) duration="--duration $2"; shift 2 ;;
         --trial-disturbance) trialdist="--disturbance $2"; shift 2 ;;
         --ref-disturbance) refdist="--disturbance $2"; shift 2 ;;
-        -h|--help) sed -n '2,60p' "$0"; exit 0 ;;
+        --ref-effect) refeffect="--effect $2"; shift 2 ;;
+        -h|--help) sed -n '2,63p' "$0"; exit 0 ;;
         *) echo "unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
@@ -115,7 +120,7 @@ export TRIALINPUT="$trialinput" TSARG="$ts $duration"
 # the sensors' noise: the trials' (and the validation record's), the reference's
 scaled() { awk -v a="$1" -v k="$noisescale" 'BEGIN { print a * k }'; }
 export TRIALNOISE="--gyro-noise $(scaled 0.03) --heading-noise $(scaled 0.2) --speed-noise $(scaled 0.02) $trialdist"
-refnoise=(--gyro-noise "$(scaled 0.02)" --heading-noise "$(scaled 0.1)" $refdist)
+refnoise=(--gyro-noise "$(scaled 0.02)" --heading-noise "$(scaled 0.1)" $refdist $refeffect)
 
 # a world's `simulate` arguments, one a line: NAME, or NAME@L for the world scaled to L m
 world_args() {

@@ -22,6 +22,9 @@ pub(super) struct AnemometerEvidence {
     pub(super) p: f64,
     /// The instrument's floor (m/s): a wind up to this is not told from a calm.
     pub(super) floor: f64,
+    /// Each set's own mean true wind speed (m/s): `[trials, reference]`, the reference's 0
+    /// without one.
+    pub(super) own: [f64; 2],
 }
 
 /// The share of the ship's speed an anemometer cannot tell from a calm: a vane 1° off the
@@ -29,6 +32,12 @@ pub(super) struct AnemometerEvidence {
 const ANEMOMETER_FLOOR: f64 = 0.027;
 
 impl AnemometerEvidence {
+    /// Whether the change is the reference's: its own true wind at least as strong as the
+    /// trials' (a wind it sailed in and the trials did not).
+    pub(super) fn the_references(&self) -> bool {
+        self.own[1] > 0.0 && self.own[1] >= self.own[0]
+    }
+
     /// Speed (m/s) and the direction it blows *from* (deg).
     pub(super) fn speed_from(&self) -> (f64, f64) {
         let [n, e] = self.wind;
@@ -82,6 +91,7 @@ pub(super) fn anemometer_evidence(
         stat(reference)?
     };
     let wind = [t[0].0 - r[0].0, t[1].0 - r[1].0];
+    let own = [t[0].0.hypot(t[1].0), r[0].0.hypot(r[1].0)];
     // what the instrument cannot tell from a calm: the share of the ship's speed that a
     // vane 1° off the bow line, or a cup reading 2 % off, makes of its own motion
     let speed = trial
@@ -107,5 +117,6 @@ pub(super) fn anemometer_evidence(
         chi,
         p: chi2_sf(chi, 2.0),
         floor,
+        own,
     })
 }

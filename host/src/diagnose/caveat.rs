@@ -148,6 +148,21 @@ pub enum Caveat {
         /// The reference's (m/s).
         reference_mps: f64,
     },
+    /// The reference records show more of a current or wind than the trials — their own
+    /// heading harmonics of the ground velocity, or the anemometer's true wind, the larger —
+    /// and the change between the two is significant: a current or wind the reference
+    /// sailed in and the trials did not. That change is not counted towards a current or
+    /// wind in the trials (a missing effect is one the trials show more of).
+    ReferenceEnvironment {
+        /// Each set's own heading harmonics of the ground velocity (m/s, root-sum-square):
+        /// `[trials, reference]`, where the ground track's change is the reference's.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        ground_mps: Option<[f64; 2]>,
+        /// Each set's own mean true wind (m/s): `[trials, reference]`, where the
+        /// anemometer's change is the reference's.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        wind_mps: Option<[f64; 2]>,
+    },
     /// A significant effect that does not improve held-out prediction was named behind
     /// the verdict by the ranking rule.
     PassedOver {
@@ -325,6 +340,33 @@ impl Caveat {
                  PRBS, or zig-zags of two amplitudes).",
                 100.0 * share
             ),
+            Caveat::ReferenceEnvironment {
+                ground_mps,
+                wind_mps,
+            } => {
+                let mut shown = Vec::new();
+                if let Some([t, r]) = ground_mps {
+                    shown.push(format!(
+                        "speed and course over ground vary with heading by ±{r:.3} m/s on the \
+                         reference, ±{t:.3} m/s on the trials"
+                    ));
+                }
+                if let Some([t, r]) = wind_mps {
+                    shown.push(format!(
+                        "the anemometer shows a true wind of {r:.2} m/s on the reference, \
+                         {t:.2} m/s on the trials"
+                    ));
+                }
+                format!(
+                    "The reference records show more current or wind than the trials ({}): \
+                     the difference is one the reference sailed in and the trials did not, \
+                     and it is not counted towards a current or wind in the trials. A model \
+                     identified on those records may carry the steady part of that wind as a \
+                     steady moment; records sailed in the trials' conditions make a better \
+                     reference.",
+                    shown.join("; ")
+                )
+            }
             Caveat::OtherManoeuvre { distance, hull } => {
                 let nulls = if hull.is_empty() {
                     "The reference records show no hull physics of their own that the null \
@@ -483,6 +525,28 @@ pub(super) fn current_without_anemometer<'a>(
                 separation: separation.unwrap_or(0.0),
             },
         })
+}
+
+/// [`Caveat::ReferenceEnvironment`] where the ground track or the anemometer shows a change
+/// significant at `level` (as a current's test or a wind's) whose larger part is the
+/// reference's own.
+pub(super) fn reference_environment(ch: &Channels, has_ref: bool, level: f64) -> Option<Caveat> {
+    if !has_ref {
+        return None;
+    }
+    let ground_mps = ch
+        .sog
+        .filter(|s| s.the_references())
+        .filter(|s| s.test(true).2 < level || s.test(false).2 < level)
+        .map(|s| s.own);
+    let wind_mps = ch
+        .anemometer
+        .filter(|a| a.the_references() && a.p < level)
+        .map(|a| a.own);
+    (ground_mps.is_some() || wind_mps.is_some()).then_some(Caveat::ReferenceEnvironment {
+        ground_mps,
+        wind_mps,
+    })
 }
 
 /// The caveat for a steady moment named (`named`: the verdict's effect and its second) on

@@ -1,19 +1,16 @@
 //! The heading and speed-over-ground channels: the gyro offset the heading shows, the
 //! heading harmonics of speed over ground (speed lost in turns taken out through a bank of
-//! surge lags) with their null covariance, and what each channel adds to an effect's evidence.
+//! surge lags) with their null covariance (what each adds to an effect's evidence:
+//! `channel_evidence.rs`).
 
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use yawcast_shared::model::EffectKind;
 
 use super::anemometer::{anemometer_evidence, AnemometerEvidence};
-use super::gyro::{gyro_offset, GyroOffset};
 use super::separation::{heading_separation, MIN_HEADING_SEPARATION};
-use super::verdict::{cfg_m, Evidence};
-use super::DiagnoseConfig;
-use crate::effects::{def, Channel};
 use crate::io::data::Record;
+use crate::io::data::{gyro_offset, GyroOffset};
 use crate::stats::{f_quantile, f_sf};
 
 /// What heading and speed over ground show on the trials against the reference: whether
@@ -402,6 +399,9 @@ pub(super) struct SogEvidence {
     /// The current seen across the track as well, when every record logs course over
     /// ground.
     pub(super) cross: Option<CrossEvidence>,
+    /// Each set's own heading harmonics of the ground velocity, root-sum-square over both
+    /// harmonics and both lanes (m/s): `[trials, reference]`, the reference's 0 without one.
+    pub(super) own: [f64; 2],
 }
 
 /// A uniform current seen by both components of the ground velocity: along the heading
@@ -454,6 +454,13 @@ impl SogEvidence {
         }
     }
 
+    /// Whether the change the ground track shows is the reference's: its own heading
+    /// harmonics at least as large as the trials' (a current or wind the reference sailed in
+    /// and the trials did not). A missing effect is one the trials show more of.
+    pub(super) fn the_references(&self) -> bool {
+        self.own[1] > 0.0 && self.own[1] >= self.own[0]
+    }
+
     /// The smallest current (m/s) speed over ground shows at the level `level` whatever its
     /// direction: the amplitude whose χ² (along the direction the records resolve worst)
     /// reaches the level's critical value.
@@ -467,7 +474,7 @@ impl SogEvidence {
     }
 
     /// The calibration in words, empty when the records show no aliasing.
-    fn calibration_words(&self, current: bool) -> String {
+    pub(super) fn calibration_words(&self, current: bool) -> String {
         let (phi, raw) = if current {
             (self.inflation[0], self.raw[0])
         } else {
@@ -501,19 +508,21 @@ pub(super) fn sog_evidence(
 }
 
 /// Harmonics of `trial` minus those of `reference` (none when empty) with the circular-shift
-/// covariance of the difference.
+/// covariance of the difference, and each set's own harmonics' root-sum-square (m/s;
+/// `[trial, reference]`, the reference's 0 when there is none).
 fn sog_difference(
     lane: Lane,
     trial: &[&Record],
     reference: &[&Record],
     taus: &[f64],
     rng: &mut ChaCha8Rng,
-) -> Option<(DVector<f64>, DMatrix<f64>)> {
+) -> Option<(DVector<f64>, DMatrix<f64>, [f64; 2])> {
     let ht = headings(trial)?;
     let t = sog_harmonics(sog_fit(lane, trial, &ht, &[], taus, None)?, trial.len());
     let vt = sog_null_cov(lane, trial, &ht, taus, &t, rng)?;
     if reference.is_empty() {
-        return Some((t, vt));
+        let own = [t.norm(), 0.0];
+        return Some((t, vt, own));
     }
     let hr = headings(reference)?;
     let r = sog_harmonics(
@@ -521,7 +530,8 @@ fn sog_difference(
         reference.len(),
     );
     let vr = sog_null_cov(lane, reference, &hr, taus, &r, rng)?;
-    Some((t - r, vt + vr))
+    let own = [t.norm(), r.norm()];
+    Some((t - r, vt + vr, own))
 }
 
 /// One lane's harmonics (trial minus reference), their covariance, the χ² of the first
@@ -529,6 +539,7 @@ fn sog_difference(
 /// of freedom per harmonic, from each record against the others of its own set.
 struct LaneStat {
     d: DVector<f64>,
+    own: [f64; 2],
     v: DMatrix<f64>,
     raw: [f64; 2],
     inflation: [f64; 2],
@@ -542,7 +553,7 @@ fn lane_stat(
     taus: &[f64],
     rng: &mut ChaCha8Rng,
 ) -> Option<LaneStat> {
-    let (d, v) = sog_difference(lane, trial, reference, taus, rng)?;
+    let (d, v, own) = sog_difference(lane, trial, reference, taus, rng)?;
     // each record against the others of its set: the aliasing without a current
     let mut sums = [0.0; 2];
     let mut splits = 0usize;
@@ -552,7 +563,7 @@ fn lane_stat(
         }
         for j in 0..set.len() {
             let rest: Vec<&Record> = (0..set.len()).filter(|&i| i != j).map(|i| set[i]).collect();
-            if let Some((dj, vj)) = sog_difference(lane, &set[j..=j], &rest, taus, rng) {
+            if let Some((dj, vj, _)) = sog_difference(lane, &set[j..=j], &rest, taus, rng) {
                 sums[0] += wald(&dj, &vj, &[0, 1]);
                 sums[1] += wald(&dj, &vj, &[2, 3]);
                 splits += 1;
@@ -573,6 +584,7 @@ fn lane_stat(
     }
     Some(LaneStat {
         d,
+        own,
         v,
         raw,
         inflation,
@@ -592,12 +604,15 @@ pub(super) fn sog_evidence_with(
     let reference: Vec<&Record> = reference.iter().collect();
     let a = lane_stat(Lane::Along, &trial, &reference, taus, &mut rng)?;
     let with_course = trial.iter().chain(&reference).all(|r| r.cog.is_some());
-    let cross = if with_course {
+    let x = if with_course {
         lane_stat(Lane::Cross, &trial, &reference, taus, &mut rng)
-            .and_then(|x| combine_current(&a, &x))
     } else {
         None
     };
+    let cross = x.as_ref().and_then(|x| combine_current(&a, x));
+    let own = x.as_ref().map_or(a.own, |x| {
+        [a.own[0].hypot(x.own[0]), a.own[1].hypot(x.own[1])]
+    });
     let (d, v, inflation) = (&a.d, &a.v, a.inflation);
     Some(SogEvidence {
         chi1: a.raw[0] / inflation[0],
@@ -610,6 +625,7 @@ pub(super) fn sog_evidence_with(
         amp2: d[2].hypot(d[3]),
         var1: inflation[0] * largest_eigenvalue(v[(0, 0)], v[(0, 1)], v[(1, 1)]),
         cross,
+        own,
     })
 }
 
@@ -645,131 +661,6 @@ fn combine_current(a: &LaneStat, x: &LaneStat) -> Option<CrossEvidence> {
 /// Largest eigenvalue of the symmetric 2×2 matrix `[[a, b], [b, c]]`.
 fn largest_eigenvalue(a: f64, b: f64, c: f64) -> f64 {
     0.5 * (a + c) + (0.25 * (a - c) * (a - c) + b * b).sqrt()
-}
-
-/// What the heading and speed-over-ground channels add to the evidence of `ev.kind`: a gyro
-/// bias judged on the heading, current and wind on speed over ground as well as on the yaw
-/// channel (either may show them).
-pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfig, ch: &Channels) {
-    let (hb, sog) = (ch.hb, ch.sog);
-    let kind = ev.kind;
-    let p_yaw = ev.p_yaw;
-    match def(kind).channel {
-        Channel::Heading => {
-            if let Some(g) = hb {
-                let (b, se) = (g.offset, g.se);
-                let z = b / se;
-                ev.p = g.p();
-                ev.statistic = z * z;
-                ev.score = z * z - 1.0;
-                ev.parameter = Some(b);
-                ev.parameter_se = Some(se);
-                ev.channel_material = true;
-                ev.words = format!(
-                    "the gyro reads {b:+.3} ± {se:.3} °/s more than the heading turns \
-                     (mean r − mean dψ/dt{}{})",
-                    if has_ref {
-                        ", trial minus reference"
-                    } else {
-                        ""
-                    },
-                    match g.dof.filter(|&d| d < 30.0) {
-                        Some(d) => format!(
-                            "; the gyro's offset wanders from record to record beyond its \
-                             noise, and the error counts that wander: a t on {d:.0} df"
-                        ),
-                        None => String::new(),
-                    }
-                );
-            }
-        }
-        Channel::SpeedOverGround => {
-            let mut p_speed = None;
-            if let Some(s) = sog {
-                let current = kind == EffectKind::Current;
-                let (chi, df, p_sog) = s.test(current);
-                p_speed = Some(p_sog);
-                let calibration = s.calibration_words(current);
-                // either channel may show it (Bonferroni over the two); only speed over
-                // ground where the yaw channel is not counted
-                ev.p = if ev.yaw_counted {
-                    (2.0 * p_yaw.min(p_sog)).min(1.0)
-                } else {
-                    p_sog
-                };
-                ev.score = ev.score.max(chi - df);
-                ev.channel_material = p_sog < cfg.alpha / cfg_m(cfg);
-                if let (EffectKind::Current, Some(c)) = (kind, s.cross) {
-                    let (speed, dir) = c.speed_dir();
-                    ev.parameter = Some(speed);
-                    ev.words.push_str(&format!(
-                        "; the ground velocity shows a current of {speed:.3} m/s setting towards \
-                         {dir:.0}° (speed over ground along the heading, course over ground \
-                         across it; χ² = {chi:.1}, 2 df, across alone {:.1}{}{})",
-                        c.cross_chi,
-                        if c.cross_inflation > 1.0 || s.inflation[0] > 1.0 {
-                            format!(
-                                "; each lane's χ² divided by what the records show against each \
-                                 other without a current: {:.1} along, {:.1} across",
-                                s.inflation[0], c.cross_inflation
-                            )
-                        } else {
-                            String::new()
-                        },
-                        if c.agree > 13.8 {
-                            format!(
-                                "; the two lanes disagree (χ² = {:.1}, 2 df): not all of it \
-                                 is a uniform current",
-                                c.agree
-                            )
-                        } else {
-                            String::new()
-                        }
-                    ));
-                } else if kind == EffectKind::Current {
-                    ev.parameter = Some(s.amp1);
-                    ev.words.push_str(&format!(
-                        "; speed over ground varies by ±{:.3} m/s with heading, fastest heading \
-                         {:.0}° (χ² = {chi:.1}, 2 df{calibration})",
-                        s.amp1, s.dir1
-                    ));
-                } else {
-                    ev.words.push_str(&format!(
-                        "; speed over ground varies with heading by ±{:.3} m/s (1st harmonic) and \
-                         ±{:.3} m/s (2nd) (χ² = {chi:.1}, 4 df{calibration})",
-                        s.amp1, s.amp2
-                    ));
-                }
-            }
-            if let (EffectKind::Wind, Some(a)) = (kind, ch.anemometer) {
-                // the direct channel: three tests now, Bonferroni over them
-                let (speed, from) = a.speed_from();
-                let p_sog = p_speed.unwrap_or(p_yaw);
-                ev.p = if ev.yaw_counted {
-                    (3.0 * p_yaw.min(a.p).min(p_sog)).min(1.0)
-                } else {
-                    (2.0 * a.p.min(p_sog)).min(1.0)
-                };
-                ev.score = ev.score.max(a.chi - 2.0);
-                ev.channel_material |= a.p < cfg.alpha / cfg_m(cfg);
-                ev.words.push_str(&format!(
-                    "; the anemometer shows a true wind of {speed:.2} m/s from {from:.0}° \
-                     (ground velocity less the apparent wind{}; beyond the instrument's \
-                     {:.2} m/s: χ² = {:.1}, 2 df, p {})",
-                    if has_ref {
-                        ", trial minus reference"
-                    } else {
-                        ""
-                    },
-                    a.floor,
-                    a.chi,
-                    super::verdict::fmt_p(a.p)
-                ));
-            }
-        }
-        // the channels carry nothing of the actuator and hull effects, nor of a moment
-        Channel::None => {}
-    }
 }
 
 #[cfg(test)]

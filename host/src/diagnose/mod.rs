@@ -96,11 +96,11 @@
 mod anemometer;
 pub mod augment;
 mod caveat;
+mod channel_evidence;
 mod channels;
 mod commands;
 pub mod compare;
 mod evidence;
-mod gyro;
 mod null;
 mod reference;
 pub mod resid;
@@ -558,6 +558,7 @@ pub fn diagnose(
     if other.is_none() {
         caveats.extend(caveat::other_speed(ch.speeds, resolution));
     }
+    caveats.extend(caveat::reference_environment(&ch, has_ref, level));
     if let Some(s) = ch
         .sog
         .filter(|_| verdict_name != EffectKind::Current.name())

@@ -242,6 +242,41 @@ fn speed_harmonics_see_a_current() {
     assert!(chi2_sf(s.chi1, 2.0) < 1e-6, "{s:?}");
     let n = sog_evidence(&records(None, &[11, 12]), &clean, 3).unwrap();
     assert!(n.amp1 < 0.05, "{n:?}");
+    // the trials show the current more than the reference: theirs
+    assert!(!s.the_references(), "{s:?}");
+    assert!(s.own[0] > 0.2 && s.own[1] < 0.5 * s.own[0], "{:?}", s.own);
+    assert!(super::caveat::reference_environment(
+        &channels::Channels::measure(&ship_recs, &clean, 3),
+        true,
+        1e-3
+    )
+    .is_none());
+    // the other way round — a current the reference sailed in and the trials did not: the
+    // change is as significant, and it is the reference's
+    let back = sog_evidence(&clean, &ship_recs, 3).unwrap();
+    assert!(
+        back.the_references() && chi2_sf(back.chi1, 2.0) < 1e-6,
+        "{back:?}"
+    );
+    let c = super::caveat::reference_environment(
+        &channels::Channels::measure(&clean, &ship_recs, 3),
+        true,
+        1e-3,
+    )
+    .expect("the caveat");
+    let Caveat::ReferenceEnvironment {
+        ground_mps: Some([t, r]),
+        wind_mps: None,
+    } = c
+    else {
+        panic!("{c:?}")
+    };
+    assert!(r > 0.2 && t < 0.5 * r, "{t} {r}");
+    assert!(c.explain().contains("on the reference"), "{}", c.explain());
+    assert_eq!(
+        serde_json::to_value(&c).unwrap()["caveat"],
+        "reference-environment"
+    );
 }
 
 #[test]

@@ -7,7 +7,8 @@ use std::collections::BTreeMap;
 use yawcast_shared::model::EffectKind;
 
 use super::augment::AugmentReport;
-use super::channels::{add_channels, Channels};
+use super::channel_evidence::add_channels;
+use super::channels::Channels;
 use super::compare::mean_fit;
 use super::evidence::{effect_with, horizon_of, Quad, Set, WorldStat};
 use super::null::{Null, Nulls};
@@ -198,7 +199,10 @@ pub(super) fn rank(
     ch: &Channels,
 ) {
     let speed = ch.sog.is_some();
-    let anemometer = ch.anemometer.map(|a| a.p);
+    // an anemometer whose change is the reference's shows the trials no wind of their own
+    let anemometer = ch
+        .anemometer
+        .map(|a| if a.the_references() { 1.0 } else { a.p });
     ev.sort_by(|a, b| {
         let key = |e: &Evidence| ((e.p < level) as u8, e.channel_material as u8);
         key(b).cmp(&key(a)).then(

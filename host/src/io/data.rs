@@ -11,6 +11,7 @@ use thiserror::Error;
 mod atomic;
 mod checks;
 mod csv_file;
+mod gyro;
 mod heading;
 mod split;
 #[cfg(test)]
@@ -30,6 +31,7 @@ pub use csv_file::{
     write_csv, Columns,
 };
 pub(crate) use csv_file::{uniform_grid, Dialect};
+pub use gyro::{gyro_offset, GyroOffset};
 pub use heading::{block_mean, heading_bias, HeadingBias};
 pub use split::{split_at_gaps, Break, BreakKind, Piece, Split};
 pub(crate) use timestamp::days_from_civil;

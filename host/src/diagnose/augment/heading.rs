@@ -14,15 +14,24 @@ use yawcast_shared::model::EffectKind;
 
 use crate::identify::model::{Effect, Model};
 use crate::identify::pem::PemReport;
-use crate::io::data::{heading_bias, HeadingBias, Record};
+use crate::io::data::{gyro_offset, heading_bias, HeadingBias, Record};
 
 /// The offset the heading measures on `est`, when `kind` is a gyro offset and every record
-/// logs heading.
+/// logs heading: the records' pooled offset, its standard error counting how far the
+/// records' own offsets wander beside the noise within each
+/// ([`gyro_offset`](crate::io::data::gyro_offset)), as diagnose judges it.
 pub(super) fn measured_offset(kind: EffectKind, est: &[Record]) -> Option<HeadingBias> {
     if kind != EffectKind::GyroBias {
         return None;
     }
-    heading_bias(est).filter(|h| h.bias.is_finite() && h.se.is_finite())
+    let g = gyro_offset(est, &[])?;
+    let n = heading_bias(est)?.n;
+    Some(HeadingBias {
+        bias: g.offset,
+        se: g.se,
+        n,
+    })
+    .filter(|h| h.bias.is_finite() && h.se.is_finite())
 }
 
 /// The records with `bias` taken off the yaw rate.
@@ -83,7 +92,8 @@ pub(super) fn heading_evidence(hb: HeadingBias) -> f64 {
 pub(super) fn note(hb: HeadingBias) -> String {
     format!(
         "the offset held at what the heading measures, {:+.4} ± {:.4} °/s (the gyro against \
-         the compass's turn; on the yaw rate alone a steady yaw moment looks the same), the \
+         the compass's turn, the error counting how far the records' own offsets wander; \
+         on the yaw rate alone a steady yaw moment looks the same), the \
          model re-identified on the yaw rate less it; the heading's evidence for it, \
          z² = {:.1}, counts in ΔAIC and ΔBIC",
         hb.bias,
@@ -139,5 +149,35 @@ mod tests {
         let hb = measured_offset(EffectKind::GyroBias, &[r.clone()]).unwrap();
         assert!((hb.bias - 0.2).abs() < 1e-12);
         assert!(measured_offset(EffectKind::Bias, &[r]).is_none());
+    }
+
+    #[test]
+    fn the_offset_measured_counts_how_far_the_records_wander() {
+        // three records whose offsets lie 0.01 °/s apart, each with ±0.03 °/s of noise: the
+        // block sums alone give 0.0001 °/s, the records' spread 0.0058, and the heading's
+        // evidence for the offset is judged on that (z² 3, not 10⁴)
+        let recs: Vec<Record> = [0.0, 0.01, 0.02]
+            .iter()
+            .map(|&o| {
+                let y = (0..900)
+                    .map(|i| o + if i % 2 == 0 { 0.03 } else { -0.03 })
+                    .collect();
+                let mut r = Record::from_uy("r", 1.0, vec![0.0; 900], y);
+                r.psi = Some(vec![90.0; 900]);
+                r
+            })
+            .collect();
+        let within = heading_bias(&recs).unwrap();
+        let hb = measured_offset(EffectKind::GyroBias, &recs).unwrap();
+        assert_eq!((hb.bias, hb.n), (within.bias, within.n));
+        assert!(
+            within.se < 1e-3 && (hb.se - 0.01 / 3f64.sqrt()).abs() < 2e-4,
+            "{hb:?}"
+        );
+        assert!(
+            (heading_evidence(hb) - 3.0).abs() < 0.2,
+            "{}",
+            heading_evidence(hb)
+        );
     }
 }

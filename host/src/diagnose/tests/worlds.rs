@@ -92,6 +92,15 @@ fn the_anemometer_shows_wind_and_not_a_current() {
     assert!((speed - speed_mps).abs() < 0.05 * speed_mps, "{speed}");
     assert!((from - from_deg).abs() < 3.0, "{from}");
     assert!(a.p < 1e-12, "{a:?}");
+    // the trials' wind, not the reference's; the other way round (a wind the reference
+    // sailed in, calm trials) the change is the reference's
+    assert!(!a.the_references(), "{a:?}");
+    let back = anemometer_evidence(&reference, &wind).unwrap();
+    assert!(back.the_references() && back.p < 1e-12, "{back:?}");
+    assert!(
+        (back.own[1] - speed).abs() < 0.01 * speed && back.own[0] < 0.1,
+        "{back:?}"
+    );
     // the same records as a ship's NMEA log (HDT, ROT, RSA, VTG, MWV): the course over
     // ground the log carries reaches the record, and the anemometer shows the same wind
     let opts = crate::io::nmea::NmeaOptions {

@@ -20,7 +20,9 @@
 //! The two look alike on the yaw rate alone (a steady output offset either way), so the one
 //! that reached the lower minimum hands it, converted through the steady gain, to the other
 //! as a further start. The heading tells them apart when every record logs it
-//! ([`heading_bias`]: the gyro's mean reading less the heading's turn, b ± se). That is a
+//! ([`gyro_offset`]: the gyro's mean reading less the heading's turn, b ± se, the error
+//! counting how far the records' own offsets wander from one to the next as a real gyro's
+//! do, beside the noise within each). That is a
 //! measurement of the gyro offset the yaw-rate likelihood does not hold, so it enters the
 //! criterion as one more Gaussian term: BIC + ((b − d)/s)², d the model's gyro offset (0
 //! without `gyro-bias`) and s the heading's standard error combined with the identified
@@ -35,7 +37,7 @@ use yawcast_shared::model::EffectKind;
 use super::{identify_with, IdentError, PemConfig, PemReport};
 use crate::identify::model::{Effect, Model};
 use crate::identify::predict;
-use crate::io::data::{block_mean, heading_bias, Record};
+use crate::io::data::{block_mean, gyro_offset, Record};
 
 /// Why an offset effect was added.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -152,7 +154,7 @@ pub fn identify(
     cfg: &PemConfig,
 ) -> Result<(PemReport, Option<OffsetChoice>), IdentError> {
     let plain = super::identify(records, None, cfg)?;
-    let hb = heading_bias(records).map(|h| [h.bias, h.se]);
+    let hb = gyro_offset(records, &[]).map(|g| [g.offset, g.se]);
     let gyro_seen = hb.is_some_and(|[b, se]| (b / se).abs() > Z_BAR);
     // an integrator or a one-step error that is not centred asks for either offset; a gyro
     // offset the heading shows, for that one

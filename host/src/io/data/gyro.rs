@@ -2,27 +2,26 @@
 //! trials less reference, judged against the noise within the records and against how far
 //! the records' own offsets wander.
 
-use super::heading_bias;
-use crate::io::data::Record;
+use super::{heading_bias, Record};
 use crate::stats::{normal_sf, student_t_sf};
 
 /// The gyro offset the heading shows: trials less reference, or the trials' own without
 /// one (°/s).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct GyroOffset {
+pub struct GyroOffset {
     /// The offset: the sets' pooled `mean r − mean dψ/dt`, trials less reference.
-    pub(super) offset: f64,
+    pub offset: f64,
     /// Its standard error: the block sums' within the records, and how far the records'
     /// own offsets wander beyond that ([`gyro_offset`]).
-    pub(super) se: f64,
+    pub se: f64,
     /// The degrees of freedom of that error (Satterthwaite's) where the records' wander
     /// adds to it (a Student t); `None` where it adds nothing (a normal).
-    pub(super) dof: Option<f64>,
+    pub dof: Option<f64>,
 }
 
 impl GyroOffset {
     /// Two-sided p-value of a zero offset.
-    pub(super) fn p(&self) -> f64 {
+    pub fn p(&self) -> f64 {
         let z = (self.offset / self.se).abs();
         let one = match self.dof {
             Some(d) => student_t_sf(z, d),
@@ -48,7 +47,27 @@ impl GyroOffset {
 /// spread is no more than the block sums give (σ² = 0), or a set has one record and the
 /// other none to spare, it is the normal test on the block sums alone. `None` without
 /// heading.
-pub(super) fn gyro_offset(est: &[Record], reference: &[Record]) -> Option<GyroOffset> {
+///
+/// ```
+/// use yawcast::io::data::{gyro_offset, Record};
+/// // three records on one course, the gyro reading 0, 0.01 and 0.02 °/s more than the
+/// // heading turns (each with ±0.03 °/s of alternating noise): the offset is their mean,
+/// // its error their spread over √3, on 2 degrees of freedom
+/// let recs: Vec<Record> = [0.0, 0.01, 0.02]
+///     .iter()
+///     .map(|&o| {
+///         let y = (0..900).map(|i| o + if i % 2 == 0 { 0.03 } else { -0.03 }).collect();
+///         let mut r = Record::from_uy("r", 1.0, vec![0.0; 900], y);
+///         r.psi = Some(vec![90.0; 900]);
+///         r
+///     })
+///     .collect();
+/// let g = gyro_offset(&recs, &[]).unwrap();
+/// assert!((g.offset - 0.01).abs() < 1e-4);
+/// assert!((g.se - 0.01 / 3f64.sqrt()).abs() < 2e-4, "{g:?}");
+/// assert!(g.dof.is_some_and(|d| (d - 2.0).abs() < 0.1) && g.p() > 0.2);
+/// ```
+pub fn gyro_offset(est: &[Record], reference: &[Record]) -> Option<GyroOffset> {
     let t = heading_bias(est)?;
     let r = if reference.is_empty() {
         None

@@ -1,0 +1,162 @@
+//! What the heading, ground-velocity and anemometer channels add to an effect's evidence: a
+//! gyro offset judged on the heading, current and wind on the ground track and the
+//! anemometer as well as on the yaw channel, and a change the reference shows more of than
+//! the trials set aside as the reference's.
+
+use yawcast_shared::model::EffectKind;
+
+use super::channels::Channels;
+use super::verdict::{cfg_m, Evidence};
+use super::DiagnoseConfig;
+use crate::effects::{def, Channel};
+
+/// What the heading and speed-over-ground channels add to the evidence of `ev.kind`: a gyro
+/// bias judged on the heading, current and wind on speed over ground as well as on the yaw
+/// channel (either may show them).
+pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfig, ch: &Channels) {
+    let (hb, sog) = (ch.hb, ch.sog);
+    let kind = ev.kind;
+    let p_yaw = ev.p_yaw;
+    match def(kind).channel {
+        Channel::Heading => {
+            if let Some(g) = hb {
+                let (b, se) = (g.offset, g.se);
+                let z = b / se;
+                ev.p = g.p();
+                ev.statistic = z * z;
+                ev.score = z * z - 1.0;
+                ev.parameter = Some(b);
+                ev.parameter_se = Some(se);
+                ev.channel_material = true;
+                ev.words = format!(
+                    "the gyro reads {b:+.3} ± {se:.3} °/s more than the heading turns \
+                     (mean r − mean dψ/dt{}{})",
+                    if has_ref {
+                        ", trial minus reference"
+                    } else {
+                        ""
+                    },
+                    match g.dof.filter(|&d| d < 30.0) {
+                        Some(d) => format!(
+                            "; the gyro's offset wanders from record to record beyond its \
+                             noise, and the error counts that wander: a t on {d:.0} df"
+                        ),
+                        None => String::new(),
+                    }
+                );
+            }
+        }
+        Channel::SpeedOverGround => {
+            let mut p_speed = None;
+            if let Some(s) = sog {
+                let current = kind == EffectKind::Current;
+                let (chi, df, p_sog) = s.test(current);
+                // a change the reference shows more of than the trials is not the trials'
+                let theirs = has_ref && s.the_references();
+                let p_sog = if theirs { 1.0 } else { p_sog };
+                p_speed = Some(p_sog);
+                let calibration = s.calibration_words(current);
+                // either channel may show it (Bonferroni over the two); only speed over
+                // ground where the yaw channel is not counted
+                ev.p = if ev.yaw_counted {
+                    (2.0 * p_yaw.min(p_sog)).min(1.0)
+                } else {
+                    p_sog
+                };
+                if !theirs {
+                    ev.score = ev.score.max(chi - df);
+                }
+                ev.channel_material = p_sog < cfg.alpha / cfg_m(cfg);
+                if let (EffectKind::Current, Some(c)) = (kind, s.cross) {
+                    let (speed, dir) = c.speed_dir();
+                    ev.parameter = Some(speed);
+                    ev.words.push_str(&format!(
+                        "; the ground velocity shows a current of {speed:.3} m/s setting towards \
+                         {dir:.0}° (speed over ground along the heading, course over ground \
+                         across it; χ² = {chi:.1}, 2 df, across alone {:.1}{}{})",
+                        c.cross_chi,
+                        if c.cross_inflation > 1.0 || s.inflation[0] > 1.0 {
+                            format!(
+                                "; each lane's χ² divided by what the records show against each \
+                                 other without a current: {:.1} along, {:.1} across",
+                                s.inflation[0], c.cross_inflation
+                            )
+                        } else {
+                            String::new()
+                        },
+                        if c.agree > 13.8 {
+                            format!(
+                                "; the two lanes disagree (χ² = {:.1}, 2 df): not all of it \
+                                 is a uniform current",
+                                c.agree
+                            )
+                        } else {
+                            String::new()
+                        }
+                    ));
+                } else if kind == EffectKind::Current {
+                    ev.parameter = Some(s.amp1);
+                    ev.words.push_str(&format!(
+                        "; speed over ground varies by ±{:.3} m/s with heading, fastest heading \
+                         {:.0}° (χ² = {chi:.1}, 2 df{calibration})",
+                        s.amp1, s.dir1
+                    ));
+                } else {
+                    ev.words.push_str(&format!(
+                        "; speed over ground varies with heading by ±{:.3} m/s (1st harmonic) and \
+                         ±{:.3} m/s (2nd) (χ² = {chi:.1}, 4 df{calibration})",
+                        s.amp1, s.amp2
+                    ));
+                }
+                if theirs {
+                    ev.words.push_str(&format!(
+                        "; not counted: the change is the reference's, whose own heading \
+                         harmonics of the ground velocity (±{:.3} m/s) are larger than the \
+                         trials' (±{:.3} m/s): a current or wind it sailed in and the trials \
+                         did not",
+                        s.own[1], s.own[0]
+                    ));
+                }
+            }
+            if let (EffectKind::Wind, Some(a)) = (kind, ch.anemometer) {
+                // the direct channel: three tests now, Bonferroni over them
+                let (speed, from) = a.speed_from();
+                let p_sog = p_speed.unwrap_or(p_yaw);
+                // a wind the reference's anemometer shows more of is not the trials'
+                let theirs = has_ref && a.the_references();
+                let p_air = if theirs { 1.0 } else { a.p };
+                ev.p = if ev.yaw_counted {
+                    (3.0 * p_yaw.min(p_air).min(p_sog)).min(1.0)
+                } else {
+                    (2.0 * p_air.min(p_sog)).min(1.0)
+                };
+                if !theirs {
+                    ev.score = ev.score.max(a.chi - 2.0);
+                }
+                ev.channel_material |= p_air < cfg.alpha / cfg_m(cfg);
+                ev.words.push_str(&format!(
+                    "; the anemometer shows a true wind of {speed:.2} m/s from {from:.0}° \
+                     (ground velocity less the apparent wind{}; beyond the instrument's \
+                     {:.2} m/s: χ² = {:.1}, 2 df, p {})",
+                    if has_ref {
+                        ", trial minus reference"
+                    } else {
+                        ""
+                    },
+                    a.floor,
+                    a.chi,
+                    super::verdict::fmt_p(a.p)
+                ));
+                if theirs {
+                    ev.words.push_str(&format!(
+                        "; not counted: the change is the reference's, whose own true wind \
+                         ({:.2} m/s) is stronger than the trials' ({:.2} m/s)",
+                        a.own[1], a.own[0]
+                    ));
+                }
+            }
+        }
+        // the channels carry nothing of the actuator and hull effects, nor of a moment
+        Channel::None => {}
+    }
+}
