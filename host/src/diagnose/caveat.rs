@@ -529,11 +529,8 @@ pub(super) fn current_without_anemometer<'a>(
 
 /// [`Caveat::ReferenceEnvironment`] where the ground track or the anemometer shows a change
 /// significant at `level` (as a current's test or a wind's) whose larger part is the
-/// reference's own.
-pub(super) fn reference_environment(ch: &Channels, has_ref: bool, level: f64) -> Option<Caveat> {
-    if !has_ref {
-        return None;
-    }
+/// reference's own (none without a reference: its own harmonics and wind are then 0).
+pub(super) fn reference_environment(ch: &Channels, level: f64) -> Option<Caveat> {
     let ground_mps = ch
         .sog
         .filter(|s| s.the_references())

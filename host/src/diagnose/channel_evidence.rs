@@ -52,7 +52,7 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
                 let current = kind == EffectKind::Current;
                 let (chi, df, p_sog) = s.test(current);
                 // a change the reference shows more of than the trials is not the trials'
-                let theirs = has_ref && s.the_references();
+                let theirs = s.the_references();
                 let p_sog = if theirs { 1.0 } else { p_sog };
                 p_speed = Some(p_sog);
                 let calibration = s.calibration_words(current);
@@ -123,7 +123,7 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
                 let (speed, from) = a.speed_from();
                 let p_sog = p_speed.unwrap_or(p_yaw);
                 // a wind the reference's anemometer shows more of is not the trials'
-                let theirs = has_ref && a.the_references();
+                let theirs = a.the_references();
                 let p_air = if theirs { 1.0 } else { a.p };
                 ev.p = if ev.yaw_counted {
                     (3.0 * p_yaw.min(p_air).min(p_sog)).min(1.0)

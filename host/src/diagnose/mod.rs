@@ -558,7 +558,7 @@ pub fn diagnose(
     if other.is_none() {
         caveats.extend(caveat::other_speed(ch.speeds, resolution));
     }
-    caveats.extend(caveat::reference_environment(&ch, has_ref, level));
+    caveats.extend(caveat::reference_environment(&ch, level));
     if let Some(s) = ch
         .sog
         .filter(|_| verdict_name != EffectKind::Current.name())

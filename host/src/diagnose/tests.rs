@@ -247,7 +247,6 @@ fn speed_harmonics_see_a_current() {
     assert!(s.own[0] > 0.2 && s.own[1] < 0.5 * s.own[0], "{:?}", s.own);
     assert!(super::caveat::reference_environment(
         &channels::Channels::measure(&ship_recs, &clean, 3),
-        true,
         1e-3
     )
     .is_none());
@@ -260,7 +259,6 @@ fn speed_harmonics_see_a_current() {
     );
     let c = super::caveat::reference_environment(
         &channels::Channels::measure(&clean, &ship_recs, 3),
-        true,
         1e-3,
     )
     .expect("the caveat");
