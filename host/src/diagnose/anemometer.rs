@@ -38,6 +38,16 @@ impl AnemometerEvidence {
         self.own[1] > 0.0 && self.own[1] >= self.own[0]
     }
 
+    /// The p-value counted towards a wind in the trials: 1 where the change is the
+    /// reference's ([`Self::the_references`]), else the test's.
+    pub(super) fn p_trials(&self) -> f64 {
+        if self.the_references() {
+            1.0
+        } else {
+            self.p
+        }
+    }
+
     /// Speed (m/s) and the direction it blows *from* (deg).
     pub(super) fn speed_from(&self) -> (f64, f64) {
         let [n, e] = self.wind;

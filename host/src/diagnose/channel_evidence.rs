@@ -124,7 +124,7 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
                 let p_sog = p_speed.unwrap_or(p_yaw);
                 // a wind the reference's anemometer shows more of is not the trials'
                 let theirs = a.the_references();
-                let p_air = if theirs { 1.0 } else { a.p };
+                let p_air = a.p_trials();
                 ev.p = if ev.yaw_counted {
                     (3.0 * p_yaw.min(p_air).min(p_sog)).min(1.0)
                 } else {

@@ -200,9 +200,7 @@ pub(super) fn rank(
 ) {
     let speed = ch.sog.is_some();
     // an anemometer whose change is the reference's shows the trials no wind of their own
-    let anemometer = ch
-        .anemometer
-        .map(|a| if a.the_references() { 1.0 } else { a.p });
+    let anemometer = ch.anemometer.map(|a| a.p_trials());
     ev.sort_by(|a, b| {
         let key = |e: &Evidence| ((e.p < level) as u8, e.channel_material as u8);
         key(b).cmp(&key(a)).then(

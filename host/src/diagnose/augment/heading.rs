@@ -14,7 +14,7 @@ use yawcast_shared::model::EffectKind;
 
 use crate::identify::model::{Effect, Model};
 use crate::identify::pem::PemReport;
-use crate::io::data::{gyro_offset, heading_bias, HeadingBias, Record};
+use crate::io::data::{gyro_offset, HeadingBias, Record};
 
 /// The offset the heading measures on `est`, when `kind` is a gyro offset and every record
 /// logs heading: the records' pooled offset, its standard error counting how far the
@@ -25,11 +25,10 @@ pub(super) fn measured_offset(kind: EffectKind, est: &[Record]) -> Option<Headin
         return None;
     }
     let g = gyro_offset(est, &[])?;
-    let n = heading_bias(est)?.n;
     Some(HeadingBias {
         bias: g.offset,
         se: g.se,
-        n,
+        n: g.n,
     })
     .filter(|h| h.bias.is_finite() && h.se.is_finite())
 }
@@ -167,7 +166,7 @@ mod tests {
                 r
             })
             .collect();
-        let within = heading_bias(&recs).unwrap();
+        let within = crate::io::data::heading_bias(&recs).unwrap();
         let hb = measured_offset(EffectKind::GyroBias, &recs).unwrap();
         assert_eq!((hb.bias, hb.n), (within.bias, within.n));
         assert!(

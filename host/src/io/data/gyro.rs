@@ -17,6 +17,8 @@ pub struct GyroOffset {
     /// The degrees of freedom of that error (Satterthwaite's) where the records' wander
     /// adds to it (a Student t); `None` where it adds nothing (a normal).
     pub dof: Option<f64>,
+    /// Samples of the trials used (as [`HeadingBias::n`](super::HeadingBias)).
+    pub n: usize,
 }
 
 impl GyroOffset {
@@ -102,6 +104,7 @@ pub fn gyro_offset(est: &[Record], reference: &[Record]) -> Option<GyroOffset> {
     };
     let var = within * within + wander;
     Some(GyroOffset {
+        n: t.n,
         offset,
         se: var.sqrt(),
         dof: (wander > 0.0).then(|| var * var / (wander * wander / dof as f64)),
