@@ -25,8 +25,10 @@ pub struct SimulateArgs {
     pub ship: Option<PathBuf>,
     /// Simulator: `lng` (the built-in 1:24 LNG carrier, pods, Ts 1 s), `kvlcc2` (the KVLCC2
     /// tanker by the MMG standard method, full scale L_pp 320 m, Ts 1 s), `mariner` (the
-    /// Mariner cargo ship, Abkowitz-type, L_pp 160.93 m, Ts 1 s) or `seiun-maru` (the Seiun
-    /// Maru, a fine 105 m training ship by the MMG standard method, Ts 1 s). The new worlds add a
+    /// Mariner cargo ship, Abkowitz-type, L_pp 160.93 m, Ts 1 s), `seiun-maru` (the Seiun
+    /// Maru, a fine 105 m training ship by the MMG standard method, Ts 1 s) or `container`
+    /// (a high-speed container ship whose steering couples with its roll, Son & Nomoto,
+    /// L_pp 175 m, Ts 1 s). The new worlds add a
     /// background yaw disturbance, gyro and compass errors and, with `--effect wind`, gusts;
     /// their `--effect`s are the built-in ship's carried over to the hull, their `prbs`
     /// holds stretched by the hull's L/U.
@@ -265,7 +267,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     if kind == WorldKind::Lng && args.disturbance != 1.0 {
         return Err(bad(
             "--disturbance: the built-in ship (--world lng) has no background yaw disturbance \
-             to scale; it is on the kvlcc2, mariner and seiun-maru worlds",
+             to scale; it is on the kvlcc2, mariner, seiun-maru and container worlds",
         ));
     }
     if args.out.is_none() && args.save_ship.is_none() {

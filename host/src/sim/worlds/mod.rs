@@ -10,12 +10,16 @@
 //! - [`WorldKind::SeiunMaru`]: the Seiun Maru, a 105 m training ship with a fine hull, by
 //!   the MMG standard method (Yoshimura & Masumoto 2012), full scale or Froude-scaled. It
 //!   was added after the diagnosis's rules were set, to check them on a hull they never saw.
+//! - [`WorldKind::Container`]: a high-speed container ship (`L_pp` 175 m) whose steering
+//!   couples with its roll, by the four-degree-of-freedom model of Son & Nomoto (1981),
+//!   full scale; added after the rules too, the one world whose equations hold a roll mode.
 //!
 //! The new worlds share one environment and one integrator:
 //!
-//! - **State** `[u, v, r, x_N, y_E, ψ]` with `u, v` the velocity *through the water* in body
-//!   axes. A current is uniform and steady in the earth frame, so the water is an inertial
-//!   frame and the hull's equations hold in it unchanged: the current carries the ship
+//! - **State** `[u, v, r, x_N, y_E, ψ, p, φ]` with `u, v` the velocity *through the water*
+//!   in body axes, and the roll rate and heel `p, φ` (0 but on a hull with a roll mode). A
+//!   current is uniform and steady in the earth frame, so the water is an inertial frame
+//!   and the hull's equations hold in it unchanged: the current carries the ship
 //!   (`ẋ_N, ẏ_E` and the logged speed over ground include it) and exerts no yaw moment.
 //! - **Wind**: relative wind (the ship's velocity over ground minus the true wind) with
 //!   Blendermann's (1994) coefficient curves for the hull's ship type ([`env::Windage`]);
@@ -58,18 +62,21 @@ use super::dynamics::{self, Model};
 use super::inputs::{self, ZigZagLogic};
 use super::manoeuvres::{TurningTracker, ZigzagTracker};
 use super::{NoiseSpec, Oracle, Scenario, Ship, SimEffect, SimError, TurningResult, ZigzagResult};
-use crate::effects::{HullScale, SimKnobs};
+use crate::effects::HullScale;
 use crate::io::data::Record;
 
+mod container;
 pub(crate) mod env;
 mod kvlcc2;
 mod mariner;
 mod mmg;
 mod oracle;
+mod physics;
 mod seiun;
 mod timed;
 
 use env::{gauss_markov, quantise, Sensors, Windage};
+use physics::{Physics, State, Weather, CALM};
 
 /// Random stream of the background yaw disturbance.
 const STREAM_BACKGROUND: u64 = 16;
@@ -101,18 +108,22 @@ pub enum WorldKind {
     /// The Seiun Maru, a fine 105 m training ship, by the MMG standard method (Yoshimura &
     /// Masumoto 2012).
     SeiunMaru,
+    /// A high-speed container ship whose steering couples with its roll (Son & Nomoto
+    /// 1981).
+    Container,
 }
 
 impl WorldKind {
     /// Every world, the built-in one first.
-    pub const ALL: [WorldKind; 4] = [
+    pub const ALL: [WorldKind; 5] = [
         WorldKind::Lng,
         WorldKind::Kvlcc2,
         WorldKind::Mariner,
         WorldKind::SeiunMaru,
+        WorldKind::Container,
     ];
 
-    /// The stable name (`lng`, `kvlcc2`, `mariner`, `seiun-maru`).
+    /// The stable name (`lng`, `kvlcc2`, `mariner`, `seiun-maru`, `container`).
     ///
     /// ```
     /// use yawcast::sim::WorldKind;
@@ -125,6 +136,7 @@ impl WorldKind {
             WorldKind::Kvlcc2 => "kvlcc2",
             WorldKind::Mariner => "mariner",
             WorldKind::SeiunMaru => "seiun-maru",
+            WorldKind::Container => "container",
         }
     }
 
@@ -169,6 +181,13 @@ pub(crate) trait Hull: std::fmt::Debug + Send + Sync {
     /// and rudder angle δ (rad, positive to starboard), with external loads `ext`
     /// (`X`, `Y` in N, `N` in N·m).
     fn accel(&self, s: [f64; 3], delta: f64, ext: [f64; 3]) -> [f64; 3];
+    /// Accelerations `(u̇, v̇, ṙ, ṗ)` at `s = [u, v, r, p, φ]` (roll rate `p`, heel `φ`),
+    /// as [`accel`](Hull::accel) otherwise. A hull without a roll mode (the default)
+    /// ignores `p, φ`, and its roll stays 0.
+    fn accel_roll(&self, s: [f64; 5], delta: f64, ext: [f64; 3]) -> [f64; 4] {
+        let a = self.accel([s[0], s[1], s[2]], delta, ext);
+        [a[0], a[1], a[2], 0.0]
+    }
 }
 
 /// One test world: a simulator and its scale.
@@ -227,6 +246,7 @@ impl World {
                 &seiun::SEIUN_MARU,
                 self.lpp.unwrap_or(seiun::LPP_FULL),
             ))),
+            WorldKind::Container => Some(Box::new(container::Container::new())),
         }
     }
 
@@ -385,148 +405,6 @@ fn lng_reference() -> (f64, f64, f64, f64) {
     (ship.main.lpp_m, ship.main.draft_m, ship.main.rho_water, u)
 }
 
-/// The effects' physics on a hull.
-#[derive(Debug, Clone)]
-struct Physics {
-    windage: Windage,
-    bias_nm: f64,
-    n_rr: f64,
-    cubic: bool,
-    gyro_bias: f64,
-    /// True wind velocity, towards (N, E), m/s.
-    wind_ne: (f64, f64),
-    /// Current velocity, towards (N, E), m/s.
-    current_ne: (f64, f64),
-    half_rho_l2d: f64,
-    half_rho_l4d: f64,
-    lpp: f64,
-}
-
-/// One sample's random environment: background moment (N·m) and gust factor.
-#[derive(Debug, Clone, Copy)]
-struct Weather {
-    moment: f64,
-    gust: f64,
-}
-
-const CALM: Weather = Weather {
-    moment: 0.0,
-    gust: 1.0,
-};
-
-impl Physics {
-    /// The physics of `effects` on `hull`, its gear with the gear effects, and the
-    /// `asymmetry` effect's gain (for [`Hull::set_asymmetry`]).
-    fn new(hull: &dyn Hull, effects: &[SimEffect]) -> (Physics, dynamics::Actuator, f64) {
-        let gear = hull.gear();
-        let k = SimKnobs::of(&merged(effects));
-        let act =
-            dynamics::Actuator::with_knobs(0.0, gear.limit_deg, gear.rate_degps, gear.tau_s, &k);
-        let (l, d, rho) = (hull.lpp(), hull.draft(), hull.rho());
-        let mut p = Physics {
-            windage: hull.windage(),
-            bias_nm: 0.0,
-            n_rr: 0.0,
-            cubic: false,
-            gyro_bias: 0.0,
-            wind_ne: (0.0, 0.0),
-            current_ne: (0.0, 0.0),
-            half_rho_l2d: 0.5 * rho * l * l * d,
-            half_rho_l4d: 0.5 * rho * l.powi(4) * d,
-            lpp: l,
-        };
-        p.bias_nm = k.yaw_moment_nm;
-        p.gyro_bias = k.gyro_bias_degps;
-        p.n_rr = k.n_rr;
-        p.cubic = k.cubic;
-        p.wind_ne = k.wind_ne;
-        p.current_ne = k.current_ne;
-        (p, act, k.starboard_gain)
-    }
-
-    /// Current and (gusting) true wind in body axes at heading ψ.
-    #[inline]
-    fn body(&self, psi: f64, gust: f64) -> ((f64, f64), (f64, f64)) {
-        let (sp, cp) = psi.sin_cos();
-        let rot = |(n, e): (f64, f64)| (n * cp + e * sp, -n * sp + e * cp);
-        let (wn, we) = self.wind_ne;
-        (rot(self.current_ne), rot((wn * gust, we * gust)))
-    }
-
-    /// Air-relative body velocity (the apparent wind comes from its direction).
-    #[inline]
-    fn air(&self, s: &[f64; 6], w: Weather) -> (f64, f64) {
-        let ((uc, vc), (uw, vw)) = self.body(s[5], w.gust);
-        (s[0] + uc - uw, s[1] + vc - vw)
-    }
-
-    /// Speed over ground.
-    fn sog(&self, s: &[f64; 6]) -> f64 {
-        let ((uc, vc), _) = self.body(s[5], 1.0);
-        (s[0] + uc).hypot(s[1] + vc)
-    }
-
-    /// Velocity over ground (north, east; m/s): the hull's through the water plus the
-    /// current.
-    fn ground_velocity(&self, s: &[f64; 6]) -> (f64, f64) {
-        let (sp, cp) = s[5].sin_cos();
-        let (cn, ce) = self.current_ne;
-        (s[0] * cp - s[1] * sp + cn, s[0] * sp + s[1] * cp + ce)
-    }
-
-    #[inline]
-    fn deriv(&self, hull: &dyn Hull, s: &[f64; 6], delta: f64, w: Weather) -> [f64; 6] {
-        let (ua, va) = self.air(s, w);
-        let (xa, ya, na) = self.windage.loads(ua, va);
-        let mut n = na + self.bias_nm + w.moment;
-        let r = s[2];
-        if self.n_rr != 0.0 {
-            n -= if self.cubic {
-                let u2 = (s[0] * s[0] + s[1] * s[1]).max(1e-8);
-                let rp = r * self.lpp / u2.sqrt();
-                self.n_rr * self.half_rho_l2d * u2 * rp * rp * rp
-            } else {
-                self.n_rr * self.half_rho_l4d * r * r.abs()
-            };
-        }
-        let a = hull.accel([s[0], s[1], r], delta, [xa, ya, n]);
-        let (vn, ve) = self.ground_velocity(s);
-        [a[0], a[1], a[2], vn, ve, r]
-    }
-
-    fn rk4(&self, hull: &dyn Hull, s: &mut [f64; 6], delta: f64, dt: f64, w: Weather) {
-        let k1 = self.deriv(hull, s, delta, w);
-        let mut tmp = [0.0; 6];
-        for i in 0..6 {
-            tmp[i] = s[i] + 0.5 * dt * k1[i];
-        }
-        let k2 = self.deriv(hull, &tmp, delta, w);
-        for i in 0..6 {
-            tmp[i] = s[i] + 0.5 * dt * k2[i];
-        }
-        let k3 = self.deriv(hull, &tmp, delta, w);
-        for i in 0..6 {
-            tmp[i] = s[i] + dt * k3[i];
-        }
-        let k4 = self.deriv(hull, &tmp, delta, w);
-        for i in 0..6 {
-            s[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-        }
-    }
-}
-
-/// The effects in force: of several of one kind, the last.
-fn merged(effects: &[SimEffect]) -> Vec<SimEffect> {
-    let mut out: Vec<SimEffect> = Vec::new();
-    for e in effects {
-        match out.iter_mut().find(|x| x.kind() == e.kind()) {
-            Some(x) => *x = *e,
-            None => out.push(*e),
-        }
-    }
-    out
-}
-
 /// Settings of one run on a hull.
 struct HullRun<'a> {
     hull: &'a dyn Hull,
@@ -568,7 +446,7 @@ impl<'a> Integrator<'a> {
     fn sample(
         &self,
         k: usize,
-        s: &mut [f64; 6],
+        s: &mut State,
         act: &mut dynamics::Actuator,
         hist: &[f64],
         w: Weather,
@@ -593,12 +471,12 @@ impl<'a> Integrator<'a> {
 /// held until the next sample.
 fn run_hull(
     mut spec: HullRun<'_>,
-    mut command: impl FnMut(usize, &[f64; 6]) -> f64,
-    mut observe: impl FnMut(usize, &[f64; 6], Weather, &dynamics::Actuator) -> bool,
+    mut command: impl FnMut(usize, &State) -> f64,
+    mut observe: impl FnMut(usize, &State, Weather, &dynamics::Actuator) -> bool,
 ) -> Result<(), SimError> {
     let (hull, phys) = (spec.hull, spec.phys);
     let u0 = hull.u0();
-    let mut s = [u0, 0.0, 0.0, 0.0, 0.0, spec.psi0_deg.to_radians()];
+    let mut s = [u0, 0.0, 0.0, 0.0, 0.0, spec.psi0_deg.to_radians(), 0.0, 0.0];
     let step = Integrator::new(hull, phys, spec.ts, spec.dt_max);
     let dt = step.dt;
     let nwarm = (spec.warmup_s / dt).ceil() as usize;
@@ -706,13 +584,13 @@ fn simulate_hull(
 
     let open = scenario.input.open_loop(n, ts, seed);
     let mut closed = inputs::Closed::of(&scenario.input, n, ts, seed);
-    let mut decide = |k: usize, s: &[f64; 6]| match (&open, closed.as_mut()) {
+    let mut decide = |k: usize, s: &State| match (&open, closed.as_mut()) {
         (Some(u), _) => u[k],
         (None, Some(c)) => c.command(k, s[5].to_degrees(), s[2].to_degrees()),
         (None, None) => 0.0,
     };
     let mut cmds = Vec::with_capacity(n);
-    let mut states: Vec<([f64; 6], Weather)> = Vec::with_capacity(n);
+    let mut states: Vec<(State, Weather)> = Vec::with_capacity(n);
     let mut gears: Vec<dynamics::Actuator> = Vec::with_capacity(n);
     run_hull(
         HullRun {

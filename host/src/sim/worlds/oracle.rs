@@ -2,13 +2,13 @@
 //! `k` samples back with the logged commands, its random processes decaying from their
 //! values there towards their means.
 
-use super::{dynamics, Integrator, Weather};
+use super::{dynamics, Integrator, State, Weather};
 
 /// What a replay needs of one run: every sample's state, weather and steering gear, the
 /// commands, and the random processes' time constants.
 pub(super) struct Replay<'a> {
     pub(super) step: Integrator<'a>,
-    pub(super) states: &'a [([f64; 6], Weather)],
+    pub(super) states: &'a [(State, Weather)],
     pub(super) gears: &'a [dynamics::Actuator],
     pub(super) cmds: &'a [f64],
     pub(super) tau_background_s: f64,

@@ -25,7 +25,12 @@ fn mean(v: &[f64]) -> f64 {
     v.iter().sum::<f64>() / v.len() as f64
 }
 
-const NEW: [WorldKind; 3] = [WorldKind::Kvlcc2, WorldKind::Mariner, WorldKind::SeiunMaru];
+const NEW: [WorldKind; 4] = [
+    WorldKind::Kvlcc2,
+    WorldKind::Mariner,
+    WorldKind::SeiunMaru,
+    WorldKind::Container,
+];
 
 #[test]
 fn the_lng_world_is_the_built_in_simulator() {
@@ -220,7 +225,7 @@ fn current_carries_the_ship_and_exerts_no_moment() {
         calm.windage.a_l = 0.0;
         calm.windage.a_f = 0.0;
         carried.windage = calm.windage;
-        let s = [h.u0(), -0.3, 0.004, 0.0, 0.0, 30f64.to_radians()];
+        let s = [h.u0(), -0.3, 0.004, 0.0, 0.0, 30f64.to_radians(), 0.0, 0.0];
         let a = calm.deriv(h.as_ref(), &s, 0.1, CALM);
         let b = carried.deriv(h.as_ref(), &s, 0.1, CALM);
         assert_eq!(a[..3], b[..3]);
@@ -335,7 +340,7 @@ fn course_over_ground_is_the_ground_velocity_with_gps_noise() {
 fn wind_moment_follows_the_blendermann_curve() {
     let w = World::new(WorldKind::Kvlcc2, None).unwrap();
     let h = w.hull().unwrap();
-    let s = [h.u0(), 0.0, 0.0, 0.0, 0.0, 0.0];
+    let s = [h.u0(), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
     let (calm, _, _) = Physics::new(h.as_ref(), &[]);
     let rdot = |from_deg: f64| {
         let wind = SimEffect::Wind {
