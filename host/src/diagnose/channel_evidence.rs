@@ -55,6 +55,7 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
                 let theirs = s.the_references();
                 let p_sog = if theirs { 1.0 } else { p_sog };
                 p_speed = Some(p_sog);
+                ev.p_ground = Some(p_sog);
                 let calibration = s.calibration_words(current);
                 // either channel may show it (Bonferroni over the two); only speed over
                 // ground where the yaw channel is not counted
