@@ -1,5 +1,6 @@
-//! The diagnosis on the test worlds' records (KVLCC2, Mariner): what their channels show of
-//! a current and the wind, and trials sailed with other commands than the reference.
+//! The diagnosis on the test worlds' records (KVLCC2, Mariner, the Seiun Maru, the container
+//! ship): what their channels show of a current and the wind, and trials sailed with other
+//! commands than the reference.
 
 use super::*;
 
@@ -516,5 +517,37 @@ fn on_a_hull_nothing_was_chosen_on_the_hidden_effect_is_named_and_nothing_else()
         assert!(words.contains("steady yaw moment equal to -0.2"), "{words}");
         let json = serde_json::to_value(&d.caveats[0]).unwrap();
         assert_eq!(json["caveat"], "reference-offset");
+    }
+}
+
+#[test]
+fn a_ship_that_rolls_reads_a_steady_moment_and_not_a_current() {
+    // The container ship (Son & Nomoto's four degrees of freedom: it heels in a turn, and
+    // the heel turns it) was added after every rule was set. Sailed as the suite sails it
+    // (seed 1, no anemometer): effect-free trials read `none`. With the canonical steady
+    // moment hidden, the trials' headings, sailed unevenly, make it a heading harmonic on
+    // the yaw channel, read by the current's regressor as well as the wind's; the yaw
+    // moment says the ship is turned, so the current is judged on its ground track, which
+    // shows none, and the steady moment is named (it was named a current before)
+    use crate::sim::WorldKind;
+    let k = WorldKind::Container;
+    let w = crate::sim::World::new(k, None).unwrap();
+    let reference = world_records(k, Vec::new(), &[900, 901, 902]);
+    let model = identify(&reference);
+    let cfg = DiagnoseConfig {
+        seed: 1,
+        ..DiagnoseConfig::default()
+    };
+    for (hidden, named) in [(None, "none"), (Some(EffectKind::Bias), "bias")] {
+        let effects = hidden.map(|e| vec![w.hidden(e, 1.0)]).unwrap_or_default();
+        let trials = world_records(k, effects, &[100, 101, 102]);
+        let d = diagnose(&model, &reference, &trials, &[], &cfg).unwrap();
+        let current = d.ranking.iter().find(|r| r.effect == "current").unwrap();
+        println!(
+            "{hidden:?}: {} ({:?}), current p {:.1e}: {}\n{}",
+            d.verdict, d.then, current.p_value, current.evidence, d.explanation
+        );
+        assert_eq!(d.verdict, named, "{}", d.explanation);
+        assert!(current.p_value > 0.01, "{current:?}");
     }
 }
