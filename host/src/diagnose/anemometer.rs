@@ -32,10 +32,11 @@ pub(super) struct AnemometerEvidence {
 const ANEMOMETER_FLOOR: f64 = 0.027;
 
 impl AnemometerEvidence {
-    /// Whether the change is the reference's: its own true wind at least as strong as the
-    /// trials' (a wind it sailed in and the trials did not).
+    /// Whether the change is the reference's: its own true wind beyond the instrument's
+    /// floor and at least as strong as the trials' (a wind it sailed in and the trials did
+    /// not; two calm sets are not that).
     pub(super) fn the_references(&self) -> bool {
-        self.own[1] > 0.0 && self.own[1] >= self.own[0]
+        self.own[1] > self.floor && self.own[1] >= self.own[0]
     }
 
     /// The p-value counted towards a wind in the trials: 1 where the change is the

@@ -12,7 +12,8 @@ use crate::effects::{def, Channel};
 
 /// What the heading and speed-over-ground channels add to the evidence of `ev.kind`: a gyro
 /// bias judged on the heading, current and wind on speed over ground as well as on the yaw
-/// channel (either may show them).
+/// channel (either may show them; a current, which carries the ship, must show on the
+/// ground track too where one is logged: [`super::verdict::carried`]).
 pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfig, ch: &Channels) {
     let (hb, sog) = (ch.hb, ch.sog);
     let kind = ev.kind;
@@ -55,7 +56,6 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
                 let theirs = s.the_references();
                 let p_sog = if theirs { 1.0 } else { p_sog };
                 p_speed = Some(p_sog);
-                ev.p_ground = Some(p_sog);
                 let calibration = s.calibration_words(current);
                 // either channel may show it (Bonferroni over the two); only speed over
                 // ground where the yaw channel is not counted
@@ -64,6 +64,9 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
                 } else {
                     p_sog
                 };
+                if current {
+                    ev.p_ground = Some(p_sog);
+                }
                 if !theirs {
                     ev.score = ev.score.max(chi - df);
                 }

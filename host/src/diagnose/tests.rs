@@ -10,7 +10,7 @@ use super::caveat::current_without_anemometer;
 use super::channels::{sog_evidence, sog_evidence_with, sog_taus};
 use super::evidence::{trial_statistic, Version};
 use super::null::{simulate_innovations, Null};
-use super::verdict::{current_or_wind, Moment};
+use super::verdict::{carried, current_or_wind, Moment};
 use super::*;
 use crate::identify::pem::{self, PemConfig};
 use crate::sim::{simulate, NoiseSpec, Scenario, Ship, SimEffect};
@@ -640,44 +640,26 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
     assert!(ev[0].channel_material);
     assert!(ev[0].words.contains("present"), "{}", ev[0].words);
     assert!(current_without_anemometer(&ev, None).is_none());
-    // the moment is the wind's, so a current is judged on its ground track: the container
-    // ship's hidden steady moment (seed 1) made the yaw channel's heading harmonic
-    // significant (p 1.3e-5 for a current, 6.1e-7 for a wind) on a ground track that shows
-    // no current (p 0.7), and the current, predicting best, was named
-    let with_ground = |kind, p, p_yaw, p_ground| Evidence {
+    // a current carries the ship: where the ground track shows none at the level, the yaw
+    // channel's heading harmonic does not name one (the container ship's hidden steady
+    // moment, seed 1: the current at p = 1.3e-5 from the yaw channel, its ground track at
+    // 0.7); where the ground track shows one, its p is the two channels' as before
+    let grounded = |p, p_ground| Evidence {
         p_ground: Some(p_ground),
-        ..evidence(kind, p, p_yaw, false)
+        ..evidence(EffectKind::Current, p, p / 2.0, false)
     };
-    for anemometer in [None, Some(1e-4)] {
-        let mut ev = vec![
-            with_ground(EffectKind::Current, 1.25e-5, 6.2e-6, 0.7),
-            evidence(EffectKind::Bias, 6.7e-10, 6.7e-10, false),
-            with_ground(EffectKind::Wind, 6.1e-7, 6.1e-7, 0.9),
-        ];
-        current_or_wind(&mut ev, level, alpha, true, anemometer);
-        let c = ev.iter().find(|e| e.kind == EffectKind::Current).unwrap();
-        let w = ev.iter().find(|e| e.kind == EffectKind::Wind).unwrap();
-        assert!(w.p < level, "{w:?}");
-        if anemometer.is_none() {
-            assert_eq!(c.p, 0.7);
-            assert!(
-                c.words
-                    .contains("judged on the ground track alone: p = 7.0e-1"),
-                "{}",
-                c.words
-            );
-        } else {
-            // where an anemometer shows the wind, the trials may hold a current beside it
-            assert_eq!(c.p, 1.25e-5);
-        }
-    }
-    // a current its ground track shows keeps that p: a wind beside it does not hide it
-    let mut ev = vec![
-        with_ground(EffectKind::Current, 2e-9, 1e-9, 1e-8),
-        with_ground(EffectKind::Wind, 1e-6, 1e-6, 0.3),
-    ];
-    current_or_wind(&mut ev, level, alpha, true, None);
-    assert_eq!(ev[1].p, 1e-8);
+    let mut ev = vec![grounded(1.25e-5, 0.7), grounded(2e-9, 1e-8)];
+    carried(&mut ev, level);
+    assert_eq!(ev[0].p, 0.7);
+    assert!(
+        ev[0]
+            .words
+            .contains("the ground track shows none (p = 7.0e-1)"),
+        "{}",
+        ev[0].words
+    );
+    assert_eq!(ev[1].p, 2e-9);
+    assert!(ev[1].words.is_empty());
     // the same speed evidence without a yaw moment: a current, wind moved behind it
     let mut ev = vec![
         evidence(EffectKind::Wind, 1e-6, 0.3, true),

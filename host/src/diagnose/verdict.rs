@@ -66,8 +66,8 @@ pub(super) struct Evidence {
     /// What set a current apart from wind where no anemometer is logged
     /// ([`current_or_wind`]).
     pub(super) moment: Option<Moment>,
-    /// p-value of the ground track alone (speed and course over ground), for current and
-    /// wind where it is logged ([`add_channels`]); a change that is the reference's counts 1.
+    /// A current's p-value on the ground track alone (speed and course over ground), where
+    /// it is logged ([`add_channels`]; 1 where the change is the reference's).
     pub(super) p_ground: Option<f64>,
 }
 
@@ -214,6 +214,7 @@ pub(super) fn rank(
         )
     });
     current_or_wind(ev, level, cfg.alpha, speed, anemometer);
+    carried(ev, level);
     // an effect `current_or_wind` left not significant (a wind the anemometer rules out)
     // leaves the significant effects' ranks, their order kept: the encompassing test is
     // between the top two significant effects, not a significant one and a discarded one
@@ -273,7 +274,11 @@ pub(super) fn current_or_wind(
         Some(_) => (
             "true wind on the anemometer",
             "the ground track moves with the wind: wind",
-            "no wind moves it, the water carries the ship: a current",
+            if ev[ic].p < level && ev[ic].p_ground.map_or(true, |pg| pg < level) {
+                "no wind moves it, the water carries the ship: a current"
+            } else {
+                "no wind moves it, and the ground track shows no current either"
+            },
         ),
         None => (
             "yaw moment varying with heading",
@@ -316,22 +321,6 @@ pub(super) fn current_or_wind(
         let w = &mut ev[iw];
         w.p = w.p.min(heading_p.max(p_decide));
         w.channel_material |= cm;
-        // the ship is turned, so the yaw channel's heading-dependent moment is the wind's;
-        // a current, which carries a ship without turning it, is judged on the ground track
-        // alone (a steady moment read on headings sailed unevenly looks like a harmonic:
-        // the container ship's hidden steady moment was named a current at p = 1.3e-5
-        // from the yaw channel while its ground track showed none, χ² = 0.7 on 2 df)
-        let c = &mut ev[ic];
-        if let Some(pg) = c.p_ground.filter(|_| anemometer.is_none()) {
-            if pg > c.p {
-                c.p = pg;
-                c.words.push_str(&format!(
-                    "; the moment is the wind's, so a current is judged on the ground track \
-                     alone: p {}",
-                    fmt_p(pg)
-                ));
-            }
-        }
     } else if anemometer.is_some() {
         // the anemometer shows no wind: a yaw moment varying with heading is then not the
         // wind's, whatever its own p (on zig-zags the hull's own moment over each swing)
@@ -352,6 +341,26 @@ pub(super) fn current_or_wind(
     if win > lose {
         let e = ev.remove(win);
         ev.insert(lose, e);
+    }
+}
+
+/// A current carries the ship, so where the ground track is logged a current must show
+/// there: where the ground track's own p does not reach `level`, the current's p is raised to
+/// it, whatever the yaw channel shows. A heading harmonic on the yaw channel
+/// alone is a moment that turns the ship — a wind (which [`current_or_wind`] has already
+/// weighed, the current's yaw evidence included), or a steady moment read on headings sailed
+/// unevenly: the container ship's hidden steady moment was named a current at p = 1.3e-5
+/// from the yaw channel, its ground track showing none (χ² = 0.7 on 2 df).
+pub(super) fn carried(ev: &mut [Evidence], level: f64) {
+    for e in ev.iter_mut().filter(|e| e.kind == EffectKind::Current) {
+        if let Some(pg) = e.p_ground.filter(|&pg| pg >= level && pg > e.p) {
+            e.p = pg;
+            e.words.push_str(&format!(
+                "; a current carries the ship, and the ground track shows none (p {}): the yaw \
+                 channel's heading-dependent moment alone does not name one",
+                fmt_p(pg)
+            ));
+        }
     }
 }
 

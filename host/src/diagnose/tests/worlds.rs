@@ -524,30 +524,39 @@ fn on_a_hull_nothing_was_chosen_on_the_hidden_effect_is_named_and_nothing_else()
 fn a_ship_that_rolls_reads_a_steady_moment_and_not_a_current() {
     // The container ship (Son & Nomoto's four degrees of freedom: it heels in a turn, and
     // the heel turns it) was added after every rule was set. Sailed as the suite sails it
-    // (seed 1, no anemometer): effect-free trials read `none`. With the canonical steady
-    // moment hidden, the trials' headings, sailed unevenly, make it a heading harmonic on
-    // the yaw channel, read by the current's regressor as well as the wind's; the yaw
-    // moment says the ship is turned, so the current is judged on its ground track, which
-    // shows none, and the steady moment is named (it was named a current before)
+    // (seed 1), without an anemometer and with one: effect-free trials read `none`. With
+    // the canonical steady moment hidden, the trials' headings, sailed unevenly, make it a
+    // heading harmonic on the yaw channel, which the current's regressor reads as well as
+    // the wind's; a current carries the ship, and the ground track shows none, so the
+    // steady moment is named (it was named a current, with the anemometer and without)
     use crate::sim::WorldKind;
     let k = WorldKind::Container;
     let w = crate::sim::World::new(k, None).unwrap();
-    let reference = world_records(k, Vec::new(), &[900, 901, 902]);
-    let model = identify(&reference);
     let cfg = DiagnoseConfig {
         seed: 1,
         ..DiagnoseConfig::default()
     };
-    for (hidden, named) in [(None, "none"), (Some(EffectKind::Bias), "bias")] {
-        let effects = hidden.map(|e| vec![w.hidden(e, 1.0)]).unwrap_or_default();
-        let trials = world_records(k, effects, &[100, 101, 102]);
-        let d = diagnose(&model, &reference, &trials, &[], &cfg).unwrap();
-        let current = d.ranking.iter().find(|r| r.effect == "current").unwrap();
-        println!(
-            "{hidden:?}: {} ({:?}), current p {:.1e}: {}\n{}",
-            d.verdict, d.then, current.p_value, current.evidence, d.explanation
-        );
-        assert_eq!(d.verdict, named, "{}", d.explanation);
-        assert!(current.p_value > 0.01, "{current:?}");
+    for log_wind in [false, true] {
+        let reference = world_records_with(k, Vec::new(), &[900, 901, 902], log_wind);
+        let model = identify(&reference);
+        for (hidden, named) in [(None, "none"), (Some(EffectKind::Bias), "bias")] {
+            let effects = hidden.map(|e| vec![w.hidden(e, 1.0)]).unwrap_or_default();
+            let trials = world_records_with(k, effects, &[100, 101, 102], log_wind);
+            let d = diagnose(&model, &reference, &trials, &[], &cfg).unwrap();
+            let current = d.ranking.iter().find(|r| r.effect == "current").unwrap();
+            println!(
+                "{hidden:?}, anemometer {log_wind}: {} ({:?}), current p {:.1e}: {}",
+                d.verdict, d.then, current.p_value, current.evidence
+            );
+            assert_eq!(d.verdict, named, "{}", d.explanation);
+            assert!(current.p_value > 0.01, "{current:?}");
+            if hidden.is_some() {
+                assert!(
+                    current.evidence.contains("the ground track shows none"),
+                    "{}",
+                    current.evidence
+                );
+            }
+        }
     }
 }
