@@ -71,6 +71,17 @@ pub(super) struct Evidence {
     pub(super) p_ground: Option<f64>,
 }
 
+impl Evidence {
+    /// The p a current keeps where its ground track is logged ([`carried`]): the ground
+    /// track's own where that does not reach `level` and is the larger, else its own.
+    fn p_carried(&self, level: f64) -> f64 {
+        match self.p_ground {
+            Some(pg) if pg >= level && pg > self.p => pg,
+            _ => self.p,
+        }
+    }
+}
+
 /// What set a current apart from wind without an anemometer ([`current_or_wind`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) enum Moment {
@@ -274,7 +285,7 @@ pub(super) fn current_or_wind(
         Some(_) => (
             "true wind on the anemometer",
             "the ground track moves with the wind: wind",
-            if ev[ic].p < level && ev[ic].p_ground.map_or(true, |pg| pg < level) {
+            if ev[ic].p_carried(level) < level {
                 "no wind moves it, the water carries the ship: a current"
             } else {
                 "no wind moves it, and the ground track shows no current either"
@@ -353,7 +364,8 @@ pub(super) fn current_or_wind(
 /// from the yaw channel, its ground track showing none (χ² = 0.7 on 2 df).
 pub(super) fn carried(ev: &mut [Evidence], level: f64) {
     for e in ev.iter_mut().filter(|e| e.kind == EffectKind::Current) {
-        if let Some(pg) = e.p_ground.filter(|&pg| pg >= level && pg > e.p) {
+        let pg = e.p_carried(level);
+        if pg != e.p {
             e.p = pg;
             e.words.push_str(&format!(
                 "; a current carries the ship, and the ground track shows none (p {}): the yaw \
