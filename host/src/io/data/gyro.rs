@@ -2,7 +2,8 @@
 //! trials less reference, judged against the noise within the records and against how far
 //! the records' own offsets wander.
 
-use super::{heading_bias, Record};
+use super::heading::{rate_less_turn, HeadingBias};
+use super::Record;
 use crate::stats::{normal_sf, student_t_sf};
 
 /// The gyro offset the heading shows: trials less reference, or the trials' own without
@@ -70,25 +71,33 @@ impl GyroOffset {
 /// assert!(g.dof.is_some_and(|d| (d - 2.0).abs() < 0.1) && g.p() > 0.2);
 /// ```
 pub fn gyro_offset(est: &[Record], reference: &[Record]) -> Option<GyroOffset> {
-    let t = heading_bias(est)?;
-    let r = if reference.is_empty() {
-        None
+    // each record's `r − dψ/dt`, formed once for the set's offset and each record's own
+    let has_reference = !reference.is_empty();
+    let est = rate_less_turn(est)?;
+    let reference = if has_reference {
+        rate_less_turn(reference)?
     } else {
-        Some(heading_bias(reference)?)
+        Vec::new()
+    };
+    let t = HeadingBias::of(&est)?;
+    let r = if has_reference {
+        Some(HeadingBias::of(&reference)?)
+    } else {
+        None
     };
     let (offset, within) = match r {
         Some(r) => (t.bias - r.bias, t.se.hypot(r.se)),
         None => (t.bias, t.se),
     };
     // each record's own offset and its block-sum variance
-    let own = |set: &[Record]| -> Vec<(f64, f64)> {
+    let own = |set: &[Vec<f64>]| -> Vec<(f64, f64)> {
         set.iter()
-            .filter_map(|rec| heading_bias(std::slice::from_ref(rec)))
+            .filter_map(|s| HeadingBias::of(std::slice::from_ref(s)))
             .map(|h| (h.bias, h.se * h.se))
             .collect()
     };
     let (mut ss, mut own_var, mut dof, mut inv_k, mut k_all) = (0.0, 0.0, 0usize, 0.0, 0usize);
-    for set in [own(est), own(reference)].iter().filter(|s| !s.is_empty()) {
+    for set in [own(&est), own(&reference)].iter().filter(|s| !s.is_empty()) {
         let k = set.len();
         let mean = set.iter().map(|b| b.0).sum::<f64>() / k as f64;
         ss += set.iter().map(|b| (b.0 - mean).powi(2)).sum::<f64>();

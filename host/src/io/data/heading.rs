@@ -26,6 +26,22 @@ pub struct HeadingBias {
 /// assert!((hb.bias - 0.2).abs() < 1e-12);
 /// ```
 pub fn heading_bias(recs: &[Record]) -> Option<HeadingBias> {
+    HeadingBias::of(&rate_less_turn(recs)?)
+}
+
+impl HeadingBias {
+    /// The pooled offset of series formed by [`rate_less_turn`]; `None` when they hold no
+    /// value.
+    pub(crate) fn of(series: &[Vec<f64>]) -> Option<HeadingBias> {
+        let (bias, se, n) = block_mean(series)?;
+        Some(HeadingBias { bias, se, n })
+    }
+}
+
+/// Each record's series `(r(t)+r(t+1))/2 − Δψ/Ts` (records shorter than 3 samples left
+/// out), or `None` when a record has no heading: what [`heading_bias`] pools, formed once
+/// where a caller wants the set's offset and each record's.
+pub(crate) fn rate_less_turn(recs: &[Record]) -> Option<Vec<Vec<f64>>> {
     let mut series = Vec::with_capacity(recs.len());
     for r in recs {
         let psi = r.psi.as_ref()?;
@@ -38,8 +54,7 @@ pub fn heading_bias(recs: &[Record]) -> Option<HeadingBias> {
                 .collect::<Vec<f64>>(),
         );
     }
-    let (bias, se, n) = block_mean(&series)?;
-    Some(HeadingBias { bias, se, n })
+    Some(series)
 }
 
 /// Pooled mean of `series` with its standard error from block sums — blocks of about √m
