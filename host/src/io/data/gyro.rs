@@ -97,7 +97,10 @@ pub fn gyro_offset(est: &[Record], reference: &[Record]) -> Option<GyroOffset> {
             .collect()
     };
     let (mut ss, mut own_var, mut dof, mut inv_k, mut k_all) = (0.0, 0.0, 0usize, 0.0, 0usize);
-    for set in [own(&est), own(&reference)].iter().filter(|s| !s.is_empty()) {
+    for set in [own(&est), own(&reference)]
+        .iter()
+        .filter(|s| !s.is_empty())
+    {
         let k = set.len();
         let mean = set.iter().map(|b| b.0).sum::<f64>() / k as f64;
         ss += set.iter().map(|b| (b.0 - mean).powi(2)).sum::<f64>();
