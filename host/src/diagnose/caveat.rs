@@ -63,6 +63,16 @@ pub enum Caveat {
         /// direction.
         smallest_mps: f64,
     },
+    /// The trials' prediction errors cannot show a steady yaw moment smaller than
+    /// `smallest_deg` (° of rudder/pod angle) at the level applied: a verdict other than a
+    /// steady moment does not rule a smaller one out (not given when one is named, first
+    /// or second).
+    MomentResolution {
+        /// The smallest steady moment (° of rudder/pod angle, either way) whose statistic
+        /// reaches the level applied against its null: one that size does about half the
+        /// time.
+        smallest_deg: f64,
+    },
     /// A current named from speed over ground alone, with no anemometer: the wind's leeway
     /// sets the ship over ground as a current does, and the yaw channel, which decides
     /// between the two without an anemometer, shows no heading-dependent moment.
@@ -267,6 +277,14 @@ impl Caveat {
                  on (in any direction, at the level applied: the headings sailed and the speed \
                  lost in turns limit it); a weaker current cannot be told.",
                 super::augment::sig(*smallest_mps)
+            ),
+            Caveat::MomentResolution { smallest_deg } => format!(
+                "The trials' {h}-step prediction errors show a steady yaw moment only from \
+                 about {}° of rudder/pod angle on, either way (at the level applied, against \
+                 its null: a moment that size reaches it about half the time); a weaker one \
+                 cannot be told from these records.",
+                sig(*smallest_deg),
+                h = super::SLOW_HORIZON
             ),
             Caveat::CurrentOrLeeway { p_moment } => format!(
                 "The current is seen on the ground track alone and no anemometer is logged: \

@@ -88,6 +88,20 @@ impl Quad {
         (self.ee - 2.0 * beta.dot(&self.se) + beta.dot(&(&self.ss * beta))).max(1e-300)
     }
 
+    /// The smallest change of a one-gain effect's gain these errors show at the level a
+    /// null's critical value `d_crit` sets: the change whose statistic
+    /// `D = n·ln(1 + β²·SᵀS/SSE)` reaches it, with the errors the best fit leaves as the
+    /// noise — an effect that size reaches the level about half the time. `None` for an
+    /// effect of more or fewer gains, or errors its regressor does not move.
+    pub(super) fn smallest_gain(&self, d_crit: f64) -> Option<f64> {
+        if self.se.len() != 1 || self.n == 0 || self.ss[(0, 0)] <= 0.0 {
+            return None;
+        }
+        let (_, sse) = self.best();
+        let b2 = (d_crit / self.n as f64).exp_m1() * sse / self.ss[(0, 0)];
+        b2.is_finite().then(|| b2.sqrt())
+    }
+
     pub(super) fn best(&self) -> (DVector<f64>, f64) {
         let p = self.se.len();
         if p == 0 {
@@ -395,4 +409,41 @@ pub(super) fn trial_stats(
             reference: version.idx.map(|i| effect_with(&cands[i], &version.beta)),
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_smallest_gain_reaches_the_critical_value() {
+        // 400 errors, SSE 100 before the gain, its regressor's SᵀS 50 and Sᵀe 10: the best
+        // gain 0.2 leaves 98
+        let q = Quad {
+            ee: 100.0,
+            se: DVector::from_element(1, 10.0),
+            ss: DMatrix::from_element(1, 1, 50.0),
+            n: 400,
+        };
+        let (b, sse) = q.best();
+        assert!(
+            (b[0] - 0.2).abs() < 1e-9 && (sse - 98.0).abs() < 1e-6,
+            "{b} {sse}"
+        );
+        let d_crit = 10.83;
+        let x = q.smallest_gain(d_crit).unwrap();
+        // a gain of x on those errors: D = n·ln((SSE + x²·SᵀS)/SSE) is the critical value
+        let d = 400.0 * ((98.0 + x * x * 50.0) / 98.0).ln();
+        assert!((d - d_crit).abs() < 1e-6, "{x} {d}");
+        assert!((x - 0.2319).abs() < 1e-4, "{x}");
+        // the larger the critical value, the larger the smallest gain shown
+        assert!(q.smallest_gain(4.0 * d_crit).unwrap() > 1.9 * x);
+        // not for two gains, nor where the regressor does not move
+        assert_eq!(Quad::zero(2).smallest_gain(d_crit), None);
+        let flat = Quad {
+            ss: DMatrix::zeros(1, 1),
+            ..q
+        };
+        assert_eq!(flat.smallest_gain(d_crit), None);
+    }
 }

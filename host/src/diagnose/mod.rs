@@ -474,6 +474,16 @@ pub fn diagnose(
         .collect();
     let mut ev = evidence;
     let level = cfg.alpha / cfg_m(cfg);
+    // the smallest steady moment the trials' errors show at the level applied, against the
+    // null its p-value is read from
+    let moment_resolution = kinds
+        .iter()
+        .position(|&k| k == EffectKind::Bias)
+        .and_then(|i| {
+            let d_crit = nulls[i].at(real[i].d).0.critical(level);
+            let h = evidence::horizon_of(EffectKind::Bias);
+            trial.family(base, &grids[i].1, h, false)[0].smallest_gain(d_crit)
+        });
     rank(base, &trial, &mut ev, &grids, level, cfg, &ch);
 
     // materiality: the effect's own held-out contribution (θ frozen, the effect's gains
@@ -567,6 +577,9 @@ pub fn diagnose(
             smallest_mps: s.smallest_current(level),
         });
     }
+    if let Some(x) = moment_resolution.filter(|_| verdict_name != EffectKind::Bias.name()) {
+        caveats.push(Caveat::MomentResolution { smallest_deg: x });
+    }
     if let Some(k) = passed_over.filter(|k| k.name() != verdict_name) {
         caveats.push(Caveat::PassedOver {
             effect: k.name().into(),
@@ -638,6 +651,9 @@ pub fn diagnose(
     if then.as_deref() == Some(EffectKind::Current.name()) {
         // a current named second: what speed over ground cannot show does not qualify it
         caveats.retain(|c| !matches!(c, Caveat::CurrentResolution { .. }));
+    }
+    if then.as_deref() == Some(EffectKind::Bias.name()) {
+        caveats.retain(|c| !matches!(c, Caveat::MomentResolution { .. }));
     }
     for c in &caveats {
         explanation.push(' ');

@@ -11,7 +11,7 @@ use crate::identify::model::{Effect, Model};
 use crate::identify::pem::{self, PemConfig};
 use crate::identify::predict::Stepper;
 use crate::io::data::Record;
-use crate::stats::{chi2_sf, standard_normal as gauss};
+use crate::stats::{chi2_sf, f_quantile, standard_normal as gauss};
 
 /// Simulates the innovations model on the commands of `like` with innovation std `sigma`
 /// (heading integrated from the simulated rate, from the record's first heading).
@@ -70,6 +70,13 @@ impl Null {
         chi2_sf(d / self.c, self.nu)
             .max(chi2_sf(d, 1.0))
             .clamp(0.0, 1.0)
+    }
+
+    /// The smallest `D` significant at `level` (the one whose [`Null::p`] is `level`): the
+    /// fitted scaled χ²'s upper `level` point, and at least χ²₁'s, as [`Null::p`] floors it.
+    pub(super) fn critical(&self, level: f64) -> f64 {
+        let q = |nu: f64| nu * f_quantile(level, nu, f64::INFINITY);
+        (self.c * q(self.nu)).max(q(1.0))
     }
 
     /// Likelihood gain above what noise alone gives (`D` minus the null's mean, at least
@@ -357,6 +364,20 @@ pub(super) fn with_spread(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_critical_value_is_where_p_reaches_the_level() {
+        let level = 0.001;
+        // a null ten times χ²₁ (50-step errors overlapping): ten times χ²₁'s 10.83
+        let wide = Null { c: 10.0, nu: 1.0 };
+        let d = wide.critical(level);
+        assert!((d - 108.28).abs() < 0.01, "{d}");
+        assert!((wide.p(d) - level).abs() < 1e-9, "{}", wide.p(d));
+        // a null of no width: χ²₁'s floor, as `p` reads it
+        let narrow = Null { c: 1e-3, nu: 0.5 };
+        assert!((narrow.critical(level) - 10.828).abs() < 1e-3);
+        assert!((narrow.p(narrow.critical(level)) - level).abs() < 1e-9);
+    }
 
     #[test]
     fn the_reference_is_cut_into_three_parts_at_least() {

@@ -539,17 +539,40 @@ fn a_ship_that_rolls_reads_a_steady_moment_and_not_a_current() {
     for log_wind in [false, true] {
         let reference = world_records_with(k, Vec::new(), &[900, 901, 902], log_wind);
         let model = identify(&reference);
+        // the smallest steady moment the effect-free trials show at the level applied
+        let mut smallest = None;
         for (hidden, named) in [(None, "none"), (Some(EffectKind::Bias), "bias")] {
             let effects = hidden.map(|e| vec![w.hidden(e, 1.0)]).unwrap_or_default();
             let trials = world_records_with(k, effects, &[100, 101, 102], log_wind);
             let d = diagnose(&model, &reference, &trials, &[], &cfg).unwrap();
             let current = d.ranking.iter().find(|r| r.effect == "current").unwrap();
+            let bias = d.ranking.iter().find(|r| r.effect == "bias").unwrap();
+            let resolution = d.caveats.iter().find_map(|c| match c {
+                Caveat::MomentResolution { smallest_deg } => Some(*smallest_deg),
+                _ => None,
+            });
             println!(
-                "{hidden:?}, anemometer {log_wind}: {} ({:?}), current p {:.1e}: {}",
-                d.verdict, d.then, current.p_value, current.evidence
+                "{hidden:?}, anemometer {log_wind}: {} ({:?}), current p {:.1e}, steady moment \
+                 {:?} (resolution {resolution:?}): {}",
+                d.verdict, d.then, current.p_value, bias.parameter, current.evidence
             );
             assert_eq!(d.verdict, named, "{}", d.explanation);
             assert!(current.p_value > 0.01, "{current:?}");
+            if hidden.is_none() {
+                // said, in degrees of rudder, where no steady moment is named
+                let r = resolution.expect("moment-resolution caveat");
+                assert!(r > 0.05 && r < 5.0, "{r}");
+                assert!(d
+                    .explanation
+                    .contains("show a steady yaw moment only from about"));
+                smallest = Some(r);
+            } else {
+                // not said where one is; the one named is larger than the smallest the
+                // effect-free trials could show
+                assert_eq!(resolution, None, "{:?}", d.caveats);
+                let named = bias.parameter.unwrap().abs();
+                assert!(named > smallest.unwrap(), "{named} vs {smallest:?}");
+            }
             if hidden.is_some() {
                 assert!(
                     current.evidence.contains("the ground track shows none"),
