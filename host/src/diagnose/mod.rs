@@ -236,6 +236,15 @@ pub struct Ranked {
     /// values — null at the grid's largest value, beyond which the truth may lie; null
     /// otherwise.
     pub parameter_uncertainty: Option<f64>,
+    /// The smallest change of `parameter` (from the version the reference shows, either
+    /// way) these trials show at the level applied, against the null `p_value` is read from
+    /// — one that size is significant about half the time: where the verdict is not this
+    /// effect, a smaller one may be there unseen. Given for the effects of one gain judged
+    /// on the yaw-rate errors (steady moment in ° of rudder/pod angle, asymmetry, nonlinear
+    /// damping, in `parameter`'s units), for the gyro offset on its heading channel (°/s)
+    /// and for the current on its ground track (m/s, in its worst direction); null for the
+    /// others (the grid-searched effects, wind) and where the records cannot give one.
+    pub resolution: Option<f64>,
     /// The evidence in words.
     pub evidence: String,
 }
@@ -474,16 +483,17 @@ pub fn diagnose(
         .collect();
     let mut ev = evidence;
     let level = cfg.alpha / cfg_m(cfg);
-    // the smallest steady moment the trials' errors show at the level applied, against the
-    // null its p-value is read from
-    let moment_resolution = kinds
+    let resolutions = resolutions(base, &trial, &kinds, &grids, &real, &nulls, level, cfg, &ch);
+    for e in ev.iter_mut() {
+        e.resolution = kinds
+            .iter()
+            .position(|&k| k == e.kind)
+            .and_then(|i| resolutions[i]);
+    }
+    let moment_resolution = ev
         .iter()
-        .position(|&k| k == EffectKind::Bias)
-        .and_then(|i| {
-            let d_crit = nulls[i].at(real[i].d).0.critical(level);
-            let h = evidence::horizon_of(EffectKind::Bias);
-            trial.family(base, &grids[i].1, h, false)[0].smallest_gain(d_crit)
-        });
+        .find(|e| e.kind == EffectKind::Bias)
+        .and_then(|e| e.resolution);
     rank(base, &trial, &mut ev, &grids, level, cfg, &ch);
 
     // materiality: the effect's own held-out contribution (θ frozen, the effect's gains
@@ -671,6 +681,39 @@ pub fn diagnose(
         after,
         reference_gear: gear.map(|g| g.model),
         verdict_effect,
+    })
+}
+
+/// The smallest change of each effect of `kinds` the trials show at `level`
+/// ([`Ranked::resolution`]): for an effect of one gain on the yaw-rate errors, the change
+/// whose statistic reaches the critical value of the null its p-value is read from, on the
+/// candidate the trials fit best ([`evidence::Quad::smallest_gain`]); for the gyro offset
+/// and the current, their channels' own.
+#[allow(clippy::too_many_arguments)]
+fn resolutions(
+    base: &Model,
+    trial: &Set<'_>,
+    kinds: &[EffectKind],
+    grids: &[(EffectKind, Vec<Effect>)],
+    real: &[evidence::WorldStat],
+    nulls: &[null::Nulls],
+    level: f64,
+    cfg: &DiagnoseConfig,
+    ch: &Channels,
+) -> Vec<Option<f64>> {
+    let idx: Vec<usize> = (0..kinds.len()).collect();
+    crate::par::map(&idx, cfg.parallel, |&i| match kinds[i] {
+        EffectKind::GyroBias => ch.hb.map(|g| g.smallest(level)),
+        EffectKind::Current => ch.sog.as_ref().map(|s| s.smallest_current(level)),
+        k if crate::effects::def(k).gains.len() == 1 => {
+            let d_crit = nulls[i].at(real[i].d).0.critical(level);
+            let quads = trial.family(base, &grids[i].1, evidence::horizon_of(k), false);
+            quads
+                .iter()
+                .min_by(|a, b| a.best().1.total_cmp(&b.best().1))?
+                .smallest_gain(d_crit)
+        }
+        _ => None,
     })
 }
 

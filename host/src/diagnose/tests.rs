@@ -466,6 +466,7 @@ pub(super) fn evidence(kind: EffectKind, p: f64, p_yaw: f64, channel_material: b
         words: String::new(),
         parameter: None,
         parameter_se: None,
+        resolution: None,
         channel_material,
         reference: None,
         speed_only: false,

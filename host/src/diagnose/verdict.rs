@@ -57,6 +57,9 @@ pub(super) struct Evidence {
     pub(super) parameter: Option<f64>,
     /// The parameter's standard error, where a channel measures it (the gyro offset).
     pub(super) parameter_se: Option<f64>,
+    /// The smallest change of the parameter the trials show at the level applied
+    /// ([`Ranked::resolution`](super::Ranked)).
+    pub(super) resolution: Option<f64>,
     pub(super) channel_material: bool,
     /// The version of the effect the reference shows (θ frozen), if any.
     pub(super) reference: Option<Effect>,
@@ -125,6 +128,7 @@ pub(super) fn effect_evidence(
         words: String::new(),
         parameter: None,
         parameter_se: None,
+        resolution: None,
         channel_material: false,
         reference: stat.reference,
         speed_only: false,
@@ -555,6 +559,7 @@ pub(super) fn ranked(
             material,
             parameter: e.parameter,
             parameter_uncertainty: e.parameter_se,
+            resolution: e.resolution,
             evidence: e.words.clone(),
         });
     }
@@ -761,6 +766,7 @@ mod tests {
             material: true,
             parameter: Some(0.151),
             parameter_uncertainty: None,
+            resolution: None,
             evidence: String::new(),
         };
         assert_eq!(

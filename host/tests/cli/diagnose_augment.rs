@@ -80,7 +80,7 @@ fn diagnose_names_a_hidden_dead_time_and_writes_stable_json() {
     // the reference's own gear (the built-in ship's slews at 20 °/s) and the smallest
     // current speed over ground would show (a few cm/s on this ship's records)
     let caveats = v["caveats"].as_array().unwrap();
-    assert_eq!(caveats.len(), 2, "{}", v["explanation"]);
+    assert_eq!(caveats.len(), 3, "{}", v["explanation"]);
     assert_eq!(caveats[0]["caveat"], "reference-gear");
     let gear = caveats[0]["words"].as_str().unwrap();
     let rate: f64 = gear
@@ -93,6 +93,20 @@ fn diagnose_names_a_hidden_dead_time_and_writes_stable_json() {
     assert_eq!(caveats[1]["caveat"], "current-resolution");
     let smallest = caveats[1]["smallest_mps"].as_f64().unwrap();
     assert!(smallest > 0.001 && smallest < 0.1, "{smallest}");
+    // and the smallest steady moment its errors show, in degrees of pod angle: under half
+    // the hidden one of the test suite (60 N·m, about 4.5°), which it names at half strength
+    assert_eq!(caveats[2]["caveat"], "moment-resolution");
+    let deg = caveats[2]["smallest_deg"].as_f64().unwrap();
+    assert!(deg > 0.01 && deg < 2.25, "{deg}");
+    // the same in the steady moment's row of the ranking; none for a grid-searched effect
+    let ranking = v["ranking"].as_array().unwrap();
+    let row = |name: &str| ranking.iter().find(|r| r["effect"] == name).unwrap();
+    assert_eq!(row("bias")["resolution"].as_f64(), Some(deg));
+    assert!(
+        row("dead-time")["resolution"].is_null(),
+        "{}",
+        row("dead-time")
+    );
     assert_eq!(v["ranking"][0]["effect"], "dead-time");
     assert!(v["ranking"][0]["p_value"].as_f64().unwrap() < 1e-3);
     assert!(v["ranking"][0]["statistic"].as_f64().unwrap() > 0.0);

@@ -4,7 +4,7 @@
 
 use super::heading::{rate_less_turn, HeadingBias};
 use super::Record;
-use crate::stats::{normal_sf, student_t_sf};
+use crate::stats::{f_quantile, normal_sf, student_t_quantile, student_t_sf};
 
 /// The gyro offset the heading shows: trials less reference, or the trials' own without
 /// one (°/s).
@@ -23,6 +23,25 @@ pub struct GyroOffset {
 }
 
 impl GyroOffset {
+    /// The smallest offset (°/s, either way) significant at `level` (two-sided, as
+    /// [`GyroOffset::p`] reads it): the t or normal quantile times the standard error.
+    ///
+    /// ```
+    /// use yawcast::io::data::GyroOffset;
+    /// let g = GyroOffset { offset: 0.0, se: 0.01, dof: None, n: 1000 };
+    /// // the normal's two-sided 1 % point, 2.576 standard errors
+    /// assert!((g.smallest(0.01) - 0.025_758).abs() < 1e-6);
+    /// let at = GyroOffset { offset: g.smallest(0.01), ..g };
+    /// assert!((at.p() - 0.01).abs() < 1e-9);
+    /// ```
+    pub fn smallest(&self, level: f64) -> f64 {
+        let q = match self.dof {
+            Some(d) => student_t_quantile(0.5 * level, d),
+            None => f_quantile(level, 1.0, f64::INFINITY).sqrt(),
+        };
+        q * self.se
+    }
+
     /// Two-sided p-value of a zero offset.
     pub fn p(&self) -> f64 {
         let z = (self.offset / self.se).abs();
