@@ -172,12 +172,22 @@ fn pp(v: f64) -> String {
     }
 }
 
+/// Three significant digits: a resolution spans mm/s (a model's current) to degrees.
+fn sig3(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return v.to_string();
+    }
+    let digits = (2 - v.abs().log10().floor() as i32).clamp(0, 6) as usize;
+    format!("{v:.digits$}")
+}
+
 fn print_report(d: &Diagnosis) {
     // ranked by the likelihood gain above noise; far-tail p-values are not compared
     // held-out gains: at the effect's own horizon ("gain pp"), then at 10 steps and in
-    // simulation (what the ranking rule compares)
+    // simulation (what the ranking rule compares); "shows from": the smallest change of the
+    // parameter the trials show at the level applied (`resolution`)
     println!(
-        "{:<18} {:>12} {:>12} {:>10} {:>9} {:>7} {:>7} {:>4} {:>4} {:>10}",
+        "{:<18} {:>12} {:>12} {:>10} {:>9} {:>7} {:>7} {:>4} {:>4} {:>10} {:>11}",
         "effect",
         "statistic",
         "above noise",
@@ -187,11 +197,12 @@ fn print_report(d: &Diagnosis) {
         "sim pp",
         "sig",
         "mat",
-        "parameter"
+        "parameter",
+        "shows from"
     );
     for r in &d.ranking {
         println!(
-            "{:<18} {:>12.1} {:>12.1} {:>10} {:>9} {:>7} {:>7} {:>4} {:>4} {:>10}",
+            "{:<18} {:>12.1} {:>12.1} {:>10} {:>9} {:>7} {:>7} {:>4} {:>4} {:>10} {:>11}",
             r.effect,
             r.statistic,
             r.above_noise,
@@ -205,7 +216,8 @@ fn print_report(d: &Diagnosis) {
             pp(r.fit_gain_sim_pp),
             if r.significant { "yes" } else { "no" },
             if r.material { "yes" } else { "no" },
-            r.parameter.map_or("-".to_string(), |p| format!("{p:.3}"))
+            r.parameter.map_or("-".to_string(), |p| format!("{p:.3}")),
+            r.resolution.map_or("-".to_string(), sig3)
         );
     }
     println!();
