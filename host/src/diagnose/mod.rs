@@ -60,7 +60,10 @@
 //!   slow disturbances are accounted for.
 //! - **Encompassing test between the top two**: both effects fitted jointly, each over its
 //!   whole grid; what each adds given the other, beyond the version the reference shows,
-//!   decides between look-alikes (dead time vs a slow gear, bias vs current vs wind).
+//!   decides between look-alikes (dead time vs a slow gear, bias vs current vs wind), on the
+//!   slower horizon of the two; where neither adds given the other there and the two are
+//!   judged on different horizons (a steady moment on 50-step errors, an asymmetry on
+//!   one-step ones), the faster horizon decides if it can.
 //! - **Ranking.** Effects are ranked by their likelihood gain above noise (`D` less its null
 //!   mean; a channel's χ² less its degrees of freedom): p-values far in the tail rest on the
 //!   shape fitted to a few dozen null replicates and cannot be compared between effects.
