@@ -342,6 +342,9 @@ pub(super) struct WorldStat {
     /// The version of the effect the reference shows (its best candidate with its gains, when
     /// it beats the model there).
     pub(super) reference: Option<Effect>,
+    /// The least-squares pieces of the best candidate on the trials, from which `d` was
+    /// measured ([`Quad::smallest_gain`] reads the resolution from them).
+    pub(super) quad: Quad,
 }
 
 /// The statistic `D` of every kind in one world: the reference version of each effect is
@@ -407,6 +410,7 @@ pub(super) fn trial_stats(
             best: effect_with(&cands[bi], &bb),
             n: tn,
             reference: version.idx.map(|i| effect_with(&cands[i], &version.beta)),
+            quad: tq[bi].clone(),
         }
     })
 }

@@ -486,7 +486,7 @@ pub fn diagnose(
         .collect();
     let mut ev = evidence;
     let level = cfg.alpha / cfg_m(cfg);
-    let resolutions = resolutions(base, &trial, &kinds, &grids, &real, &nulls, level, cfg, &ch);
+    let resolutions = resolutions(&kinds, &real, &nulls, level, &ch);
     for e in ev.iter_mut() {
         e.resolution = kinds
             .iter()
@@ -690,34 +690,29 @@ pub fn diagnose(
 /// The smallest change of each effect of `kinds` the trials show at `level`
 /// ([`Ranked::resolution`]): for an effect of one gain on the yaw-rate errors, the change
 /// whose statistic reaches the critical value of the null its p-value is read from, on the
-/// candidate the trials fit best ([`evidence::Quad::smallest_gain`]); for the gyro offset
-/// and the current, their channels' own.
-#[allow(clippy::too_many_arguments)]
+/// errors of the candidate the trials fit best, as `real[i]` measured its statistic
+/// ([`evidence::Quad::smallest_gain`]); for the gyro offset and the current, their
+/// channels' own.
 fn resolutions(
-    base: &Model,
-    trial: &Set<'_>,
     kinds: &[EffectKind],
-    grids: &[(EffectKind, Vec<Effect>)],
     real: &[evidence::WorldStat],
     nulls: &[null::Nulls],
     level: f64,
-    cfg: &DiagnoseConfig,
     ch: &Channels,
 ) -> Vec<Option<f64>> {
-    let idx: Vec<usize> = (0..kinds.len()).collect();
-    crate::par::map(&idx, cfg.parallel, |&i| match kinds[i] {
-        EffectKind::GyroBias => ch.hb.map(|g| g.smallest(level)),
-        EffectKind::Current => ch.sog.as_ref().map(|s| s.smallest_current(level)),
-        k if crate::effects::def(k).gains.len() == 1 => {
-            let d_crit = nulls[i].at(real[i].d).0.critical(level);
-            let quads = trial.family(base, &grids[i].1, evidence::horizon_of(k), false);
-            quads
-                .iter()
-                .min_by(|a, b| a.best().1.total_cmp(&b.best().1))?
-                .smallest_gain(d_crit)
-        }
-        _ => None,
-    })
+    kinds
+        .iter()
+        .enumerate()
+        .map(|(i, &k)| match k {
+            EffectKind::GyroBias => ch.hb.map(|g| g.smallest(level)),
+            EffectKind::Current => ch.sog.as_ref().map(|s| s.smallest_current(level)),
+            k if crate::effects::def(k).gains.len() == 1 => {
+                let d_crit = nulls[i].at(real[i].d).0.critical(level);
+                real[i].quad.smallest_gain(d_crit)
+            }
+            _ => None,
+        })
+        .collect()
 }
 
 /// The inputs [`diagnose`] refuses (its `# Errors`).
