@@ -10,8 +10,9 @@
 #
 #   --yawcast PATH    the binary (default: build the ci profile and use it)
 #   --work DIR        records, models and diagnoses (default target/bench-worlds)
-#   --worlds LIST     comma-separated worlds (default lng,kvlcc2,mariner; seiun-maru and
-#                     container, the worlds nothing was chosen on, by name); NAME@L is the
+#   --worlds LIST     comma-separated worlds (default lng,kvlcc2,mariner; seiun-maru,
+#                     container and esso-osaka, the worlds nothing was chosen on, by
+#                     name); NAME@L is the
 #                     world Froude-scaled to a length L m (`simulate --scale L`; e.g.
 #                     kvlcc2@7, the tanker at model scale, Ts 0.15 s)
 #   --seeds N         seeds per case (default 3)
@@ -270,7 +271,7 @@ def accounted(augmented):
     """The effects the model augment writes accounts for: a current in the yaw-rate model
     or in its heading/track part."""
     return {"current" if x == "track-current" else x for x in augmented.split("+")}
-order = ["lng", "kvlcc2", "mariner", "seiun-maru", "container"]
+order = ["lng", "kvlcc2", "mariner", "seiun-maru", "container", "esso-osaka"]
 worlds = sorted({r[0] for r in allrows},
                 key=lambda w: (order.index(w) if w in order else len(order), w))
 print(f"# Cross-world diagnosis ({len(allrows)} cases, {secs} s on {cores} cores)\n")

@@ -26,17 +26,18 @@ pub struct SimulateArgs {
     /// Simulator: `lng` (the built-in 1:24 LNG carrier, pods, Ts 1 s), `kvlcc2` (the KVLCC2
     /// tanker by the MMG standard method, full scale L_pp 320 m, Ts 1 s), `mariner` (the
     /// Mariner cargo ship, Abkowitz-type, L_pp 160.93 m, Ts 1 s), `seiun-maru` (the Seiun
-    /// Maru, a fine 105 m training ship by the MMG standard method, Ts 1 s) or `container`
+    /// Maru, a fine 105 m training ship by the MMG standard method, Ts 1 s), `container`
     /// (a high-speed container ship whose steering couples with its roll, Son & Nomoto,
-    /// L_pp 175 m, Ts 1 s). The new worlds add a
+    /// L_pp 175 m, Ts 1 s) or `esso-osaka` (the Esso Osaka tanker, its rudder in the
+    /// propeller's race, Van Berlekom & Goddard, L_pp 304.8 m, Ts 1 s). The new worlds add a
     /// background yaw disturbance, gyro and compass errors and, with `--effect wind`, gusts;
     /// their `--effect`s are the built-in ship's carried over to the hull, their `prbs`
     /// holds stretched by the hull's L/U.
     #[arg(long, value_name = "NAME", default_value = "lng")]
     pub world: String,
-    /// Length between perpendiculars (m) of a Froude-scaled `--world kvlcc2` or
-    /// `seiun-maru` (speeds and times by √(L/L_full), L_full 320 or 105 m; the default Ts
-    /// too).
+    /// Length between perpendiculars (m) of a Froude-scaled `--world kvlcc2`, `seiun-maru`
+    /// or `esso-osaka` (speeds and times by √(L/L_full), L_full 320, 105 or 304.8 m; the
+    /// default Ts too).
     #[arg(long, value_name = "L_M")]
     pub scale: Option<f64>,
     /// Switch on a library effect, by its name (docs/formats.md; a wrong name lists them),
@@ -49,7 +50,7 @@ pub struct SimulateArgs {
     /// Record length (s).
     #[arg(long, value_name = "S", default_value_t = 1800.0)]
     pub duration: f64,
-    /// Sample time (s); default 1, on a scaled kvlcc2 or seiun-maru √(L/L_full).
+    /// Sample time (s); default 1, on a scaled world √(L/L_full).
     #[arg(long, value_name = "S")]
     pub ts: Option<f64>,
     /// Command: `prbs` (identification input, random switching, 5–20°), `zigzag:10/10`,
@@ -267,7 +268,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     if kind == WorldKind::Lng && args.disturbance != 1.0 {
         return Err(bad(
             "--disturbance: the built-in ship (--world lng) has no background yaw disturbance \
-             to scale; it is on the kvlcc2, mariner, seiun-maru and container worlds",
+             to scale; it is on the kvlcc2, mariner, seiun-maru, container and esso-osaka worlds",
         ));
     }
     if args.out.is_none() && args.save_ship.is_none() {

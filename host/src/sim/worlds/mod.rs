@@ -13,6 +13,10 @@
 //! - [`WorldKind::Container`]: a high-speed container ship (`L_pp` 175 m) whose steering
 //!   couples with its roll, by the four-degree-of-freedom model of Son & Nomoto (1981),
 //!   full scale; added after the rules too, the one world whose equations hold a roll mode.
+//! - [`WorldKind::EssoOsaka`]: the Esso Osaka, a 304.8 m tanker whose rudder works in the
+//!   propeller's race, by the model of Van Berlekom & Goddard (1972), full scale or
+//!   Froude-scaled (at 3.0 m the hull of the tank records in `tests/data/real`); added
+//!   after the rules too.
 //!
 //! The new worlds share one environment and one integrator:
 //!
@@ -73,6 +77,7 @@ mod mmg;
 mod oracle;
 mod physics;
 mod seiun;
+mod tanker;
 mod timed;
 
 use env::{gauss_markov, quantise, Sensors, Windage};
@@ -111,19 +116,23 @@ pub enum WorldKind {
     /// A high-speed container ship whose steering couples with its roll (Son & Nomoto
     /// 1981).
     Container,
+    /// The Esso Osaka tanker, its rudder in the propeller's race (Van Berlekom & Goddard
+    /// 1972).
+    EssoOsaka,
 }
 
 impl WorldKind {
     /// Every world, the built-in one first.
-    pub const ALL: [WorldKind; 5] = [
+    pub const ALL: [WorldKind; 6] = [
         WorldKind::Lng,
         WorldKind::Kvlcc2,
         WorldKind::Mariner,
         WorldKind::SeiunMaru,
         WorldKind::Container,
+        WorldKind::EssoOsaka,
     ];
 
-    /// The stable name (`lng`, `kvlcc2`, `mariner`, `seiun-maru`, `container`).
+    /// The stable name (`lng`, `kvlcc2`, `mariner`, `seiun-maru`, `container`, `esso-osaka`).
     ///
     /// ```
     /// use yawcast::sim::WorldKind;
@@ -137,6 +146,7 @@ impl WorldKind {
             WorldKind::Mariner => "mariner",
             WorldKind::SeiunMaru => "seiun-maru",
             WorldKind::Container => "container",
+            WorldKind::EssoOsaka => "esso-osaka",
         }
     }
 
@@ -205,20 +215,23 @@ pub struct World {
 }
 
 impl World {
-    /// The world `kind`, at `L_pp = scale_lpp` metres when given (the MMG hulls, KVLCC2 and
-    /// the Seiun Maru, only: the built-in ship is a model already, the Mariner model is full
-    /// scale only).
+    /// The world `kind`, at `L_pp = scale_lpp` metres when given (KVLCC2, the Seiun Maru
+    /// and the Esso Osaka only: the built-in ship is a model already, the Mariner and
+    /// container models are full scale only).
     ///
     /// # Errors
     /// [`SimError::Invalid`] (`world.scale`) for a scale on another world or outside
     /// 1–1000 m.
     pub fn new(kind: WorldKind, scale_lpp: Option<f64>) -> Result<World, SimError> {
         if let Some(l) = scale_lpp {
-            if !matches!(kind, WorldKind::Kvlcc2 | WorldKind::SeiunMaru) {
+            if !matches!(
+                kind,
+                WorldKind::Kvlcc2 | WorldKind::SeiunMaru | WorldKind::EssoOsaka
+            ) {
                 return Err(SimError::invalid(
                     "world.scale",
                     l,
-                    "no scale: only kvlcc2 and seiun-maru take one",
+                    "no scale: only kvlcc2, seiun-maru and esso-osaka take one",
                 ));
             }
             super::ship::within("world.scale", l, 1.0, 1000.0)?;
@@ -247,6 +260,9 @@ impl World {
                 self.lpp.unwrap_or(seiun::LPP_FULL),
             ))),
             WorldKind::Container => Some(Box::new(container::Container::new())),
+            WorldKind::EssoOsaka => Some(Box::new(tanker::Tanker::new(
+                self.lpp.unwrap_or(tanker::LPP_FULL),
+            ))),
         }
     }
 

@@ -25,11 +25,12 @@ fn mean(v: &[f64]) -> f64 {
     v.iter().sum::<f64>() / v.len() as f64
 }
 
-const NEW: [WorldKind; 4] = [
+const NEW: [WorldKind; 5] = [
     WorldKind::Kvlcc2,
     WorldKind::Mariner,
     WorldKind::SeiunMaru,
     WorldKind::Container,
+    WorldKind::EssoOsaka,
 ];
 
 #[test]
