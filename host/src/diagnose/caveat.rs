@@ -73,6 +73,16 @@ pub enum Caveat {
         /// time.
         smallest_deg: f64,
     },
+    /// The trials' prediction errors cannot show a yaw moment varying with heading (a
+    /// wind's) smaller than `smallest_deg` at the level applied, and no anemometer is logged
+    /// to show the wind itself: a verdict other than wind does not rule a weaker one out (not
+    /// given when wind is named, first or second, nor where the yaw channel is not counted).
+    WindResolution {
+        /// The smallest such moment (° of rudder/pod angle: the amplitude of a moment
+        /// varying once per turn, as a wind's mostly does, at the direction the headings
+        /// sailed show least) whose statistic reaches the level applied against its null.
+        smallest_deg: f64,
+    },
     /// A current named from speed over ground alone, with no anemometer: the wind's leeway
     /// sets the ship over ground as a current does, and the yaw channel, which decides
     /// between the two without an anemometer, shows no heading-dependent moment.
@@ -283,6 +293,15 @@ impl Caveat {
                  about {}° of rudder/pod angle on, either way (at the level applied, against \
                  its null: a moment that size reaches it about half the time); a weaker one \
                  cannot be told from these records.",
+                sig(*smallest_deg),
+                h = super::SLOW_HORIZON
+            ),
+            Caveat::WindResolution { smallest_deg } => format!(
+                "The trials' {h}-step prediction errors show a yaw moment varying once per \
+                 turn of heading, as a wind's does, only from an amplitude of about {}° of \
+                 rudder/pod angle on (from the direction these headings show least, at the \
+                 level applied against its null); a weaker wind cannot be told from these \
+                 records without an anemometer.",
                 sig(*smallest_deg),
                 h = super::SLOW_HORIZON
             ),

@@ -88,17 +88,28 @@ impl Quad {
         (self.ee - 2.0 * beta.dot(&self.se) + beta.dot(&(&self.ss * beta))).max(1e-300)
     }
 
-    /// The smallest change of a one-gain effect's gain these errors show at the level a
-    /// null's critical value `d_crit` sets: the change whose statistic
-    /// `D = n·ln(1 + β²·SᵀS/SSE)` reaches it, with the errors the best fit leaves as the
-    /// noise — an effect that size reaches the level about half the time. `None` for an
-    /// effect of more or fewer gains, or errors its regressor does not move.
-    pub(super) fn smallest_gain(&self, d_crit: f64) -> Option<f64> {
-        if self.se.len() != 1 || self.n == 0 || self.ss[(0, 0)] <= 0.0 {
+    /// The smallest change of an effect's gains these errors show at the level a null's
+    /// critical value `d_crit` sets: the change whose statistic
+    /// `D = n·ln(1 + βᵀSᵀSβ/SSE)` reaches it, with the errors the best fit leaves as the
+    /// noise — an effect that size reaches the level about half the time. Of one gain,
+    /// `|β|` itself; of several, the length `|β|` of a change of the gains `within` alone
+    /// (the others 0) in the direction the errors show least: the smallest eigenvalue of
+    /// their block of `SᵀS`. `None` without errors, with `within` empty or out of range, or
+    /// where some direction of those gains does not move the errors.
+    pub(super) fn smallest_gain(&self, d_crit: f64, within: &[usize]) -> Option<f64> {
+        let p = self.se.len();
+        if self.n == 0 || within.is_empty() || within.iter().any(|&i| i >= p) {
+            return None;
+        }
+        let m = within.len();
+        let block = DMatrix::from_fn(m, m, |a, b| self.ss[(within[a], within[b])]);
+        let least = block.clone().symmetric_eigenvalues().min();
+        // (a NaN eigenvalue fails the comparison too)
+        if least.partial_cmp(&(1e-12 * block.trace())) != Some(std::cmp::Ordering::Greater) {
             return None;
         }
         let (_, sse) = self.best();
-        let b2 = (d_crit / self.n as f64).exp_m1() * sse / self.ss[(0, 0)];
+        let b2 = (d_crit / self.n as f64).exp_m1() * sse / least;
         b2.is_finite().then(|| b2.sqrt())
     }
 
@@ -435,19 +446,59 @@ mod tests {
             "{b} {sse}"
         );
         let d_crit = 10.83;
-        let x = q.smallest_gain(d_crit).unwrap();
+        let x = q.smallest_gain(d_crit, &[0]).unwrap();
         // a gain of x on those errors: D = n·ln((SSE + x²·SᵀS)/SSE) is the critical value
         let d = 400.0 * ((98.0 + x * x * 50.0) / 98.0).ln();
         assert!((d - d_crit).abs() < 1e-6, "{x} {d}");
         assert!((x - 0.2319).abs() < 1e-4, "{x}");
         // the larger the critical value, the larger the smallest gain shown
-        assert!(q.smallest_gain(4.0 * d_crit).unwrap() > 1.9 * x);
-        // not for two gains, nor where the regressor does not move
-        assert_eq!(Quad::zero(2).smallest_gain(d_crit), None);
+        assert!(q.smallest_gain(4.0 * d_crit, &[0]).unwrap() > 1.9 * x);
+        // not without errors, nor without a gain, nor where the regressor does not move
+        assert_eq!(Quad::zero(2).smallest_gain(d_crit, &[0, 1]), None);
+        assert_eq!(q.smallest_gain(d_crit, &[]), None);
+        assert_eq!(q.smallest_gain(d_crit, &[1]), None);
         let flat = Quad {
             ss: DMatrix::zeros(1, 1),
             ..q
         };
-        assert_eq!(flat.smallest_gain(d_crit), None);
+        assert_eq!(flat.smallest_gain(d_crit, &[0]), None);
+    }
+
+    /// Of several gains, the direction the errors show least decides: the length of a
+    /// change along the eigenvector of the smallest eigenvalue of their block of SᵀS whose
+    /// D is the critical value; a change of some gains alone reads their block only.
+    #[test]
+    fn of_several_gains_the_worst_direction_decides() {
+        // the first two gains' block has eigenvalues 70 and 20 (eigenvectors (1, 1)/√2 and
+        // (1, −1)/√2); the third is correlated with them
+        let q = Quad {
+            ee: 100.0,
+            se: DVector::zeros(3),
+            ss: DMatrix::from_row_slice(
+                3,
+                3,
+                &[45.0, 25.0, 10.0, 25.0, 45.0, 0.0, 10.0, 0.0, 30.0],
+            ),
+            n: 400,
+        };
+        let d_crit = 13.8;
+        let x = q.smallest_gain(d_crit, &[0, 1]).unwrap();
+        let d_of = |b: &[f64]| {
+            let b = DVector::from_column_slice(b);
+            400.0 * ((100.0 + b.dot(&(&q.ss * &b))) / 100.0).ln()
+        };
+        let h = x / 2f64.sqrt();
+        assert!((d_of(&[h, -h, 0.0]) - d_crit).abs() < 1e-6, "{x}");
+        // along the other eigenvector the same length shows more
+        assert!(d_of(&[h, h, 0.0]) > 3.0 * d_crit);
+        // all three gains: a direction shown still less, so a longer change
+        assert!(q.smallest_gain(d_crit, &[0, 1, 2]).unwrap() > x);
+        // a direction the gains do not move: none
+        let singular = Quad {
+            ss: DMatrix::from_row_slice(2, 2, &[1.0, 1.0, 1.0, 1.0]),
+            se: DVector::zeros(2),
+            ..q
+        };
+        assert_eq!(singular.smallest_gain(d_crit, &[0, 1]), None);
     }
 }

@@ -486,17 +486,21 @@ pub fn diagnose(
         .collect();
     let mut ev = evidence;
     let level = cfg.alpha / cfg_m(cfg);
-    let resolutions = resolutions(&kinds, &real, &nulls, level, &ch);
+    let resolutions = resolutions(&kinds, &real, &nulls, level, &ch, &ev);
     for e in ev.iter_mut() {
         e.resolution = kinds
             .iter()
             .position(|&k| k == e.kind)
             .and_then(|i| resolutions[i]);
     }
-    let moment_resolution = ev
-        .iter()
-        .find(|e| e.kind == EffectKind::Bias)
-        .and_then(|e| e.resolution);
+    let of = |kind: EffectKind| {
+        ev.iter()
+            .find(|e| e.kind == kind)
+            .and_then(|e| e.resolution)
+    };
+    let moment_resolution = of(EffectKind::Bias);
+    let current_resolution = of(EffectKind::Current);
+    let wind_resolution = of(EffectKind::Wind).filter(|_| ch.anemometer.is_none());
     rank(base, &trial, &mut ev, &grids, level, cfg, &ch);
 
     // materiality: the effect's own held-out contribution (θ frozen, the effect's gains
@@ -571,10 +575,7 @@ pub fn diagnose(
     );
     // speed through the water: told apart from a current only as far as the ground track
     // resolves one
-    let resolution = ch
-        .sog
-        .as_ref()
-        .map_or(f64::INFINITY, |s| s.smallest_current(level));
+    let resolution = current_resolution.unwrap_or(f64::INFINITY);
     // only where both sets were sailed with alike commands: on a zig-zag the straight speed
     // is an extrapolation to a rudder held amidships, which the records never show
     // (effect-free zig-zags against a PRBS reference read 3.7 m/s against 7.7 on Mariner)
@@ -582,16 +583,14 @@ pub fn diagnose(
         caveats.extend(caveat::other_speed(ch.speeds, resolution));
     }
     caveats.extend(caveat::reference_environment(&ch, level));
-    if let Some(s) = ch
-        .sog
-        .filter(|_| verdict_name != EffectKind::Current.name())
-    {
-        caveats.push(Caveat::CurrentResolution {
-            smallest_mps: s.smallest_current(level),
-        });
+    if let Some(x) = current_resolution.filter(|_| verdict_name != EffectKind::Current.name()) {
+        caveats.push(Caveat::CurrentResolution { smallest_mps: x });
     }
     if let Some(x) = moment_resolution.filter(|_| verdict_name != EffectKind::Bias.name()) {
         caveats.push(Caveat::MomentResolution { smallest_deg: x });
+    }
+    if let Some(x) = wind_resolution.filter(|_| verdict_name != EffectKind::Wind.name()) {
+        caveats.push(Caveat::WindResolution { smallest_deg: x });
     }
     if let Some(k) = passed_over.filter(|k| k.name() != verdict_name) {
         caveats.push(Caveat::PassedOver {
@@ -668,6 +667,9 @@ pub fn diagnose(
     if then.as_deref() == Some(EffectKind::Bias.name()) {
         caveats.retain(|c| !matches!(c, Caveat::MomentResolution { .. }));
     }
+    if then.as_deref() == Some(EffectKind::Wind.name()) {
+        caveats.retain(|c| !matches!(c, Caveat::WindResolution { .. }));
+    }
     for c in &caveats {
         explanation.push(' ');
         explanation.push_str(&c.explain());
@@ -688,31 +690,73 @@ pub fn diagnose(
 }
 
 /// The smallest change of each effect of `kinds` the trials show at `level`
-/// ([`Ranked::resolution`]): for an effect of one gain on the yaw-rate errors, the change
+/// ([`Ranked::resolution`]): for an effect with gains on the yaw-rate errors, the change
 /// whose statistic reaches the critical value of the null its p-value is read from, on the
 /// errors of the candidate the trials fit best, as `real[i]` measured its statistic
-/// ([`evidence::Quad::smallest_gain`]); for the gyro offset and the current, their
-/// channels' own.
+/// ([`evidence::Quad::smallest_gain`]; of the wind, the amplitude of a once-per-turn moment
+/// in the direction the errors show least, [`resolved_gains`]); for the gyro offset and
+/// the current, their channels' own. An effect whose p is the best of several channels
+/// (Bonferroni over them, `channel_evidence`) shows on one of them at `level` over their
+/// number; one whose yaw channel is not counted has no resolution there.
 fn resolutions(
     kinds: &[EffectKind],
     real: &[evidence::WorldStat],
     nulls: &[null::Nulls],
     level: f64,
     ch: &Channels,
+    ev: &[verdict::Evidence],
 ) -> Vec<Option<f64>> {
     kinds
         .iter()
         .enumerate()
-        .map(|(i, &k)| match k {
-            EffectKind::GyroBias => ch.hb.map(|g| g.smallest(level)),
-            EffectKind::Current => ch.sog.as_ref().map(|s| s.smallest_current(level)),
-            k if crate::effects::def(k).gains.len() == 1 => {
-                let d_crit = nulls[i].at(real[i].d).0.critical(level);
-                real[i].quad.smallest_gain(d_crit)
+        .map(|(i, &k)| {
+            let counted = ev[i].yaw_counted;
+            match k {
+                EffectKind::GyroBias => ch.hb.map(|g| g.smallest(level)),
+                EffectKind::Current => {
+                    // the yaw channel's and the ground track's
+                    let m = if counted { 2.0 } else { 1.0 };
+                    ch.sog.as_ref().map(|s| s.smallest_current(level / m))
+                }
+                EffectKind::Wind if !counted => None,
+                k if !crate::effects::def(k).gains.is_empty() => {
+                    // the wind's yaw channel beside the ground track and the anemometer
+                    let m = if k == EffectKind::Wind {
+                        1.0 + f64::from(u8::from(ch.sog.is_some()))
+                            + f64::from(u8::from(ch.anemometer.is_some()))
+                    } else {
+                        1.0
+                    };
+                    let d_crit = nulls[i].at(real[i].d).0.critical(level / m);
+                    real[i].quad.smallest_gain(d_crit, &resolved_gains(k))
+                }
+                _ => None,
             }
-            _ => None,
         })
         .collect()
+}
+
+/// The gains of `kind` its resolution is read along: all of them, but of the wind's the
+/// once-per-turn harmonic alone. A wind's moment is mostly that: the rudder that holds
+/// course against the hidden winds of the test worlds varies with heading once per turn by
+/// 0.6–1.9° and twice by 0.01–0.5°, and the twice-per-turn regressors, correlated with the
+/// once-per-turn ones over the headings sailed, would make the worst direction a mix no
+/// wind has.
+fn resolved_gains(kind: EffectKind) -> Vec<usize> {
+    let gains = crate::effects::def(kind).gains;
+    let first: Vec<usize> = (0..gains.len())
+        .filter(|&j| {
+            matches!(
+                gains[j].1,
+                crate::effects::Regressor::Sin1 | crate::effects::Regressor::Cos1
+            )
+        })
+        .collect();
+    if kind == EffectKind::Wind && !first.is_empty() {
+        first
+    } else {
+        (0..gains.len()).collect()
+    }
 }
 
 /// The inputs [`diagnose`] refuses (its `# Errors`).

@@ -80,7 +80,7 @@ fn diagnose_names_a_hidden_dead_time_and_writes_stable_json() {
     // the reference's own gear (the built-in ship's slews at 20 °/s) and the smallest
     // current speed over ground would show (a few cm/s on this ship's records)
     let caveats = v["caveats"].as_array().unwrap();
-    assert_eq!(caveats.len(), 3, "{}", v["explanation"]);
+    assert_eq!(caveats.len(), 4, "{}", v["explanation"]);
     assert_eq!(caveats[0]["caveat"], "reference-gear");
     let gear = caveats[0]["words"].as_str().unwrap();
     let rate: f64 = gear
@@ -102,6 +102,12 @@ fn diagnose_names_a_hidden_dead_time_and_writes_stable_json() {
     let ranking = v["ranking"].as_array().unwrap();
     let row = |name: &str| ranking.iter().find(|r| r["effect"] == name).unwrap();
     assert_eq!(row("bias")["resolution"].as_f64(), Some(deg));
+    // and, with no anemometer logged, the smallest moment varying once per turn of
+    // heading (a wind's) its errors show, in the wind's row too
+    assert_eq!(caveats[3]["caveat"], "wind-resolution");
+    let wind = caveats[3]["smallest_deg"].as_f64().unwrap();
+    assert!(wind > 0.01 && wind < 10.0, "{wind}");
+    assert_eq!(row("wind")["resolution"].as_f64(), Some(wind));
     assert!(
         row("dead-time")["resolution"].is_null(),
         "{}",

@@ -1,5 +1,5 @@
 //! The diagnosis on the test worlds' records (KVLCC2, Mariner, the Seiun Maru, the container
-//! ship): what their channels show of a current and the wind, and trials sailed with other
+//! ship, the Esso Osaka): what their channels show of a current and the wind, and trials sailed with other
 //! commands than the reference.
 
 use super::*;
@@ -629,4 +629,58 @@ fn an_asymmetry_a_steady_moment_mimics_on_slow_errors_is_told_on_fast_ones() {
         "{}",
         asym.evidence
     );
+}
+
+#[test]
+fn a_tanker_of_a_third_family_reads_its_effects_and_says_what_wind_it_cannot_see() {
+    // The Esso Osaka (Van Berlekom & Goddard: the rudder in the propeller's race, hull
+    // forces in modulus form) was added after every rule was set. Sailed as the suite sails
+    // it (seed 1, no anemometer): effect-free trials read `none` and say the smallest
+    // once-per-turn moment their errors would show. The canonical wind, which the rudder
+    // holds course against with 0.71° varying once per turn
+    // (`a_winds_moment_varies_with_heading_mostly_once_per_turn`), lies under it and reads
+    // `none` with the same caveat; a slew limit in the gear is named
+    use crate::sim::WorldKind;
+    let k = WorldKind::EssoOsaka;
+    let w = crate::sim::World::new(k, None).unwrap();
+    let cfg = DiagnoseConfig {
+        seed: 1,
+        ..DiagnoseConfig::default()
+    };
+    let reference = world_records(k, Vec::new(), &[900, 901, 902]);
+    let model = identify(&reference);
+    for (hidden, named) in [
+        (None, "none"),
+        (Some(EffectKind::Wind), "none"),
+        (Some(EffectKind::RateLimit), "rate-limit"),
+    ] {
+        let effects = hidden.map(|e| vec![w.hidden(e, 1.0)]).unwrap_or_default();
+        let trials = world_records(k, effects, &[100, 101, 102]);
+        let d = diagnose(&model, &reference, &trials, &[], &cfg).unwrap();
+        let wind = d.ranking.iter().find(|r| r.effect == "wind").unwrap();
+        let caveat = d.caveats.iter().find_map(|c| match c {
+            Caveat::WindResolution { smallest_deg } => Some(*smallest_deg),
+            _ => None,
+        });
+        println!(
+            "{hidden:?}: {} ({:?}); wind p {:.2}, resolution {:?}",
+            d.verdict, d.then, wind.p_value, wind.resolution
+        );
+        assert_eq!(d.verdict, named, "{}", d.explanation);
+        // said where wind is not named, and the same figure as the ranking's
+        let r = caveat.expect("wind-resolution caveat");
+        assert_eq!(wind.resolution, Some(r));
+        assert!(r > 0.71 && r < 20.0, "{r}");
+        assert!(d
+            .explanation
+            .contains("show a yaw moment varying once per turn of heading"));
+        let json = serde_json::to_value(&d.caveats).unwrap();
+        assert!(
+            json.as_array()
+                .unwrap()
+                .iter()
+                .any(|c| c["caveat"] == "wind-resolution" && c["smallest_deg"].as_f64() == Some(r)),
+            "{json}"
+        );
+    }
 }
