@@ -271,7 +271,8 @@ impl Hull for Container {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{calm_run, run_hull, Physics, World, WorldKind};
+    use super::super::tests::manoeuvres;
+    use super::super::{calm_run, run_hull, Physics, WorldKind};
     use super::*;
 
     /// The heel (deg) at every sample of a calm turn on 20° of rudder.
@@ -330,21 +331,9 @@ mod tests {
     /// ship with a small metacentric height heels.
     #[test]
     fn turning_circle_and_zigzag_look_like_a_fast_ship() {
-        let w = World::new(WorldKind::Container, None).unwrap();
-        let tc = w.turning_circle(35.0).unwrap();
-        let z = w.zigzag(10.0, 10.0).unwrap();
-        println!(
-            "container 35°: advance {:.2} L, tactical diameter {:.2} L, steady r {:.3} °/s, U {:.2} m/s; 10/10: {z:?}",
-            tc.advance_m / LPP,
-            tc.tactical_diameter_m / LPP,
-            tc.steady_r_degps,
-            tc.steady_speed_mps
-        );
-        assert!(
-            (2.0..5.0).contains(&(tc.tactical_diameter_m / LPP)),
-            "{tc:?}"
-        );
-        assert!((2.0..4.5).contains(&(tc.advance_m / LPP)), "{tc:?}");
+        let (adv, td, tc, z) = manoeuvres(WorldKind::Container);
+        assert!((2.0..5.0).contains(&td), "{tc:?}");
+        assert!((2.0..4.5).contains(&adv), "{tc:?}");
         assert!(tc.steady_speed_mps < 0.9 * 8.287, "{tc:?}");
         assert!((1.0..15.6).contains(&z.first_overshoot_deg), "{z:?}");
     }

@@ -217,7 +217,8 @@ impl Hull for Tanker {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{World, WorldKind};
+    use super::super::tests::manoeuvres;
+    use super::super::WorldKind;
     use super::*;
 
     #[test]
@@ -267,21 +268,9 @@ mod tests {
     /// speed falling from 8.23 to 2.42 m/s, overshoots 6.3° and 14.7°.
     #[test]
     fn turning_circle_and_zigzag_look_like_a_vlcc() {
-        let w = World::new(WorldKind::EssoOsaka, None).unwrap();
-        let tc = w.turning_circle(35.0).unwrap();
-        let z = w.zigzag(10.0, 10.0).unwrap();
-        println!(
-            "esso-osaka 35°: advance {:.2} L, tactical diameter {:.2} L, steady r {:.3} °/s, U {:.2} m/s; 10/10: {z:?}",
-            tc.advance_m / LPP_FULL,
-            tc.tactical_diameter_m / LPP_FULL,
-            tc.steady_r_degps,
-            tc.steady_speed_mps
-        );
-        assert!(
-            (2.0..5.0).contains(&(tc.tactical_diameter_m / LPP_FULL)),
-            "{tc:?}"
-        );
-        assert!((2.0..4.5).contains(&(tc.advance_m / LPP_FULL)), "{tc:?}");
+        let (adv, td, tc, z) = manoeuvres(WorldKind::EssoOsaka);
+        assert!((2.0..5.0).contains(&td), "{tc:?}");
+        assert!((2.0..4.5).contains(&adv), "{tc:?}");
         assert!(tc.steady_speed_mps < 0.8 * U0_FULL, "{tc:?}");
         assert!((1.0..20.0).contains(&z.first_overshoot_deg), "{z:?}");
     }

@@ -14,6 +14,23 @@ fn quiet(n: usize, effects: Vec<SimEffect>, w: &World) -> Scenario {
     }
 }
 
+/// The 35° turning circle and the 10°/10° zig-zag of full-scale `kind`, printed in
+/// lengths: `(advance / L, tactical diameter / L, the turn, the zig-zag)`.
+pub(super) fn manoeuvres(kind: WorldKind) -> (f64, f64, TurningResult, ZigzagResult) {
+    let w = World::new(kind, None).unwrap();
+    let l = w.hull().unwrap().lpp();
+    let tc = w.turning_circle(35.0).unwrap();
+    let z = w.zigzag(10.0, 10.0).unwrap();
+    let (adv, td) = (tc.advance_m / l, tc.tactical_diameter_m / l);
+    println!(
+        "{} 35°: advance {adv:.2} L, tactical diameter {td:.2} L, steady r {:.3} °/s, U {:.2} m/s; 10/10: {z:?}",
+        kind.name(),
+        tc.steady_r_degps,
+        tc.steady_speed_mps
+    );
+    (adv, td, tc, z)
+}
+
 fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
     a.iter()
         .zip(b)
