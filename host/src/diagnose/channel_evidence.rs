@@ -59,6 +59,7 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
                 let calibration = s.calibration_words(current);
                 // either channel may show it (Bonferroni over the two); only speed over
                 // ground where the yaw channel is not counted
+                ev.channels = if ev.yaw_counted { 2 } else { 1 };
                 ev.p = if ev.yaw_counted {
                     (2.0 * p_yaw.min(p_sog)).min(1.0)
                 } else {
@@ -129,6 +130,7 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
                 // a wind the reference's anemometer shows more of is not the trials'
                 let theirs = a.the_references();
                 let p_air = a.p_trials();
+                ev.channels = if ev.yaw_counted { 3 } else { 2 };
                 ev.p = if ev.yaw_counted {
                     (3.0 * p_yaw.min(p_air).min(p_sog)).min(1.0)
                 } else {

@@ -710,24 +710,14 @@ fn resolutions(
         .iter()
         .enumerate()
         .map(|(i, &k)| {
-            let counted = ev[i].yaw_counted;
+            // each channel of an effect's p shows it at the level over their number
+            let at = level / f64::from(ev[i].channels);
             match k {
                 EffectKind::GyroBias => ch.hb.map(|g| g.smallest(level)),
-                EffectKind::Current => {
-                    // the yaw channel's and the ground track's
-                    let m = if counted { 2.0 } else { 1.0 };
-                    ch.sog.as_ref().map(|s| s.smallest_current(level / m))
-                }
-                EffectKind::Wind if !counted => None,
+                EffectKind::Current => ch.sog.as_ref().map(|s| s.smallest_current(at)),
+                _ if !ev[i].yaw_counted => None,
                 k if !crate::effects::def(k).gains.is_empty() => {
-                    // the wind's yaw channel beside the ground track and the anemometer
-                    let m = if k == EffectKind::Wind {
-                        1.0 + f64::from(u8::from(ch.sog.is_some()))
-                            + f64::from(u8::from(ch.anemometer.is_some()))
-                    } else {
-                        1.0
-                    };
-                    let d_crit = nulls[i].at(real[i].d).0.critical(level / m);
+                    let d_crit = nulls[i].at(real[i].d).0.critical(at);
                     real[i].quad.smallest_gain(d_crit, &resolved_gains(k))
                 }
                 _ => None,

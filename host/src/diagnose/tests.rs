@@ -472,6 +472,7 @@ pub(super) fn evidence(kind: EffectKind, p: f64, p_yaw: f64, channel_material: b
         speed_only: false,
         moment: None,
         p_ground: None,
+        channels: 1,
     }
 }
 

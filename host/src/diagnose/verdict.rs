@@ -72,6 +72,9 @@ pub(super) struct Evidence {
     /// A current's p-value on the ground track alone (speed and course over ground), where
     /// it is logged ([`add_channels`]; 1 where the change is the reference's).
     pub(super) p_ground: Option<f64>,
+    /// The number of channels `p` is the best of (Bonferroni over them, [`add_channels`]):
+    /// each shows the effect at the level over this number. 1 for the yaw channel alone.
+    pub(super) channels: u8,
 }
 
 impl Evidence {
@@ -134,6 +137,7 @@ pub(super) fn effect_evidence(
         speed_only: false,
         moment: None,
         p_ground: None,
+        channels: 1,
     };
     let pct = 100.0 * (1.0 - (-d / tn.max(1) as f64).exp());
     yaw_words(&mut ev, ts, pct);

@@ -1,6 +1,6 @@
 //! The diagnosis on the test worlds' records (KVLCC2, Mariner, the Seiun Maru, the container
-//! ship, the Esso Osaka): what their channels show of a current and the wind, and trials sailed with other
-//! commands than the reference.
+//! ship, the Esso Osaka): what their channels show of a current and the wind, and trials
+//! sailed with other commands than the reference.
 
 use super::*;
 

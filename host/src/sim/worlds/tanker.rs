@@ -3,10 +3,10 @@
 //! terms, and the only test world whose rudder works in the screw's slipstream alone.
 //!
 //! Source: Van Berlekom, W. B. & Goddard, T. A. (1972), *Maneuvering of large tankers*,
-//! Transactions of SNAME 80, 264–298 — the coefficients (the "bis" system: accelerations in
-//! `g`, lengths in `L`) as transcribed in Fossen's Marine Systems Simulator, `tanker.m`
-//! (Lauvdal 1994, with its 2005 correction of the race's velocity). The equations are the
-//! model's own, unlike the other worlds':
+//! Transactions of SNAME 80, 264–298 — the coefficients (forces per unit of the ship's
+//! mass, so the equations give accelerations) as transcribed in Fossen's Marine Systems
+//! Simulator, `tanker.m` (Lauvdal 1994, with its 2005 correction of the race's velocity).
+//! The equations are the model's own, unlike the other worlds':
 //!
 //! - The rudder acts through the velocity of the propeller's race, `c² = c_un·u·n + c_nn·n²`,
 //!   not the hull's speed: `Y = Y_ccδ c|c| δ + Y_ccββδ c|c| |β|β |δ|`, and so `N`. It keeps
