@@ -14,7 +14,9 @@
 #                     container and esso-osaka, the worlds nothing was chosen on, by
 #                     name); NAME@L is the
 #                     world Froude-scaled to a length L m (`simulate --scale L`; e.g.
-#                     kvlcc2@7, the tanker at model scale, Ts 0.15 s)
+#                     kvlcc2@7, the tanker at model scale, Ts 0.15 s); a suffix :U sails
+#                     it at the approach speed U m/s (`simulate --speed U`; e.g.
+#                     esso-osaka@3:0.3, the pond records' model and speed)
 #   --seeds N         seeds per case (default 3)
 #   --strengths LIST  comma-separated effect strengths (default 1,0.5)
 #   --effects LIST    comma-separated effects (default: none and every library effect); a
@@ -123,10 +125,13 @@ scaled() { awk -v a="$1" -v k="$noisescale" 'BEGIN { print a * k }'; }
 export TRIALNOISE="--gyro-noise $(scaled 0.03) --heading-noise $(scaled 0.2) --speed-noise $(scaled 0.02) $trialdist"
 refnoise=(--gyro-noise "$(scaled 0.02)" --heading-noise "$(scaled 0.1)" $refdist $refeffect)
 
-# a world's `simulate` arguments, one a line: NAME, or NAME@L for the world scaled to L m
+# a world's `simulate` arguments, one a line: NAME, NAME@L for the world scaled to L m,
+# either with :U for the approach speed U m/s
 world_args() {
-    printf '%s\n' --world "${1%@*}"
-    if [[ "$1" == *@* ]]; then printf '%s\n' --scale "${1#*@}"; fi
+    local base="${1%%:*}"
+    printf '%s\n' --world "${base%@*}"
+    if [[ "$base" == *@* ]]; then printf '%s\n' --scale "${base#*@}"; fi
+    if [[ "$1" == *:* ]]; then printf '%s\n' --speed "${1#*:}"; fi
 }
 export -f world_args
 

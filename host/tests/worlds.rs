@@ -77,7 +77,33 @@ fn kvlcc2_writes_the_usual_columns_seeded() {
         .collect();
     assert!((r[0] - (7.0f64 / 320.0).sqrt()).abs() < 1e-6, "{r:?}");
     assert!((1.0..1.4).contains(&r[4]), "{r:?}");
+    // the same model at the approach speed asked: its speed over ground starts there
     let js = d.join("s.json");
+    let slow = simulate(
+        &d,
+        "slow.csv",
+        &[
+            "--world",
+            "kvlcc2",
+            "--scale",
+            "7",
+            "--speed",
+            "0.6",
+            "--json",
+            js.to_str().unwrap(),
+        ],
+    );
+    let r: Vec<f64> = slow
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .map(|x| x.parse().unwrap())
+        .collect();
+    assert!((0.55..0.65).contains(&r[4]), "{r:?}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&js).unwrap()).unwrap();
+    assert_eq!(summary["ship"], "KVLCC2 (MMG, Lpp 7 m) at 0.6 m/s");
     let mar = simulate(
         &d,
         "mar.csv",
@@ -136,6 +162,18 @@ fn ship_files_and_scales_belong_to_their_worlds() {
     ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("--scale"), "{}", stderr(&o));
+    // an approach speed: not on the Mariner, whose equations are written about theirs, and
+    // within 0.25–1.5 times a world's design speed, which the message gives
+    for (world, speed, says) in [
+        ("mariner", "5", "design speed"),
+        ("esso-osaka", "20", "design speed of 8.23 m/s"),
+        ("lng", "1", "ship file"),
+    ] {
+        let o = run(&["simulate", "--world", world, "--speed", speed, "--out", out]);
+        assert_eq!(o.status.code(), Some(2));
+        let e = stderr(&o);
+        assert!(e.contains("--speed") && e.contains(says), "{e}");
+    }
     let o = run(&["simulate", "--world", "titanic", "--out", out]);
     assert_eq!(o.status.code(), Some(2));
     let e = stderr(&o);

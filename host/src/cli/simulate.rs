@@ -40,6 +40,12 @@ pub struct SimulateArgs {
     /// default Ts too).
     #[arg(long, value_name = "L_M")]
     pub scale: Option<f64>,
+    /// Approach speed through the water (m/s at the world's scale) instead of the design
+    /// speed: the propeller turns at the revolutions that hold it straight ahead (kvlcc2,
+    /// seiun-maru, container and esso-osaka; 0.25–1.5 times the design speed). For records
+    /// of a ship that ran slower than its source's design speed, as tank tests often do.
+    #[arg(long, value_name = "MPS")]
+    pub speed: Option<f64>,
     /// Switch on a library effect, by its name (docs/formats.md; a wrong name lists them),
     /// at its canonical strength (repeatable).
     #[arg(long, value_name = "NAME")]
@@ -213,6 +219,12 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         )));
     }
     let world = World::new(kind, args.scale).map_err(|e| bad(format!("--scale: {e}")))?;
+    let world = match args.speed {
+        Some(u) => world
+            .at_speed(u)
+            .map_err(|e| bad(format!("--speed: {e}")))?,
+        None => world,
+    };
     let records: Vec<PathBuf> = match &args.out {
         Some(out) => (1..=args.records)
             .map(|i| numbered(out, i, args.records))

@@ -125,23 +125,28 @@ fn poly(c: &[f64; 12], v: f64, r: f64, p: f64, phi: f64) -> f64 {
 
 impl Container {
     pub(crate) fn new() -> Container {
-        let u0 = FROUDE * (G * LPP).sqrt();
         let mut h = Container {
-            u0,
+            u0: 0.0,
             n_p: 1.0,
             asym: 0.0,
         };
-        // revolutions for equilibrium on a straight course: the surge force rises with n
-        let (mut lo, mut hi) = (0.1, 10.0);
-        for _ in 0..200 {
-            h.n_p = 0.5 * (lo + hi);
-            if h.forces([u0, 0.0, 0.0, 0.0, 0.0], 0.0)[0] > 0.0 {
-                hi = h.n_p;
-            } else {
-                lo = h.n_p;
-            }
-        }
+        h.hold(FROUDE * (G * LPP).sqrt());
         h
+    }
+
+    /// Sets the approach speed `u0` and the revolutions that hold it on a straight course:
+    /// the surge force rises with n.
+    fn hold(&mut self, u0: f64) {
+        self.u0 = u0;
+        let h = self.clone();
+        self.n_p = crate::sim::bisect(0.1, 10.0, 200, |n| {
+            Container {
+                n_p: n,
+                ..h.clone()
+            }
+            .forces([u0, 0.0, 0.0, 0.0, 0.0], 0.0)[0]
+                > 0.0
+        });
     }
 
     /// The propeller's revolutions (rev/s).
@@ -239,6 +244,11 @@ impl Hull for Container {
 
     fn set_asymmetry(&mut self, gain: f64) {
         self.asym = gain;
+    }
+
+    fn set_approach_speed(&mut self, u: f64) -> bool {
+        self.hold(u);
+        true
     }
 
     fn accel(&self, s: [f64; 3], delta: f64, ext: [f64; 3]) -> [f64; 3] {

@@ -238,6 +238,12 @@ impl Hull for Mmg {
         self.asym = gain;
     }
 
+    fn set_approach_speed(&mut self, u: f64) -> bool {
+        self.u0 = u;
+        self.n_p = self.revolutions_for(u);
+        true
+    }
+
     fn accel(&self, s: [f64; 3], delta: f64, ext: [f64; 3]) -> [f64; 3] {
         let c = self.c;
         let [u, v, r] = s;

@@ -187,6 +187,12 @@ pub(crate) trait Hull: std::fmt::Debug + Send + Sync {
     fn windage(&self) -> Windage;
     /// Sets the `asymmetry` effect's extra rudder effectiveness to starboard.
     fn set_asymmetry(&mut self, gain: f64);
+    /// Sails at approach speed `u` (m/s at this scale) instead: the propeller turns at the
+    /// revolutions that hold it on a straight course. `false` where the equations are
+    /// written about their design speed and cannot (the default).
+    fn set_approach_speed(&mut self, _u: f64) -> bool {
+        false
+    }
     /// Accelerations `(u̇, v̇, ṙ)` at the water-relative body velocities `s = [u, v, r]`
     /// and rudder angle δ (rad, positive to starboard), with external loads `ext`
     /// (`X`, `Y` in N, `N` in N·m).
@@ -212,6 +218,8 @@ pub(crate) trait Hull: std::fmt::Debug + Send + Sync {
 pub struct World {
     kind: WorldKind,
     lpp: Option<f64>,
+    /// Approach speed set by the user (m/s at the world's scale).
+    speed: Option<f64>,
 }
 
 impl World {
@@ -239,7 +247,79 @@ impl World {
         Ok(World {
             kind,
             lpp: scale_lpp,
+            speed: None,
         })
+    }
+
+    /// The same world sailing at approach speed `u_mps` (m/s at its scale, through the
+    /// water, straight ahead) instead of its design speed: the propeller turns at the
+    /// revolutions that hold it, and everything the world scales by the hull's speed (its
+    /// time `L_pp/U`, the background disturbance's time constant, the hidden yaw moment)
+    /// follows. For records of a ship that ran slower or faster than the source's design
+    /// speed — tank tests often do. KVLCC2, the Seiun Maru, the container ship and the Esso
+    /// Osaka only: the Mariner's equations are written about their design speed, and the
+    /// built-in ship's speed is its ship file's.
+    ///
+    /// ```
+    /// use yawcast::sim::{World, WorldKind};
+    /// let w = World::new(WorldKind::EssoOsaka, Some(3.0)).unwrap().at_speed(0.3).unwrap();
+    /// assert_eq!(w.approach_speed(), 0.3);
+    /// assert!(World::new(WorldKind::Mariner, None).unwrap().at_speed(5.0).is_err());
+    /// ```
+    ///
+    /// # Errors
+    /// [`SimError::Invalid`] (`world.speed`) on the Mariner or the built-in ship, for a
+    /// speed outside 0.25–1.5 times the design speed (the range the sources' coefficients
+    /// are fitted over, about), or where no revolutions hold it.
+    pub fn at_speed(self, u_mps: f64) -> Result<World, SimError> {
+        let Some(mut h) = self.design_hull() else {
+            return Err(SimError::invalid(
+                "world.speed",
+                u_mps,
+                "no approach speed on the built-in ship: set its ship file's",
+            ));
+        };
+        let design = h.u0();
+        if !u_mps.is_finite() || u_mps < 0.25 * design || u_mps > 1.5 * design {
+            return Err(SimError::invalid(
+                "world.speed",
+                u_mps,
+                &format!(
+                    "0.25–1.5 times the world's design speed of {} m/s at its scale",
+                    sig3(design)
+                ),
+            ));
+        }
+        if !h.set_approach_speed(u_mps) {
+            return Err(SimError::invalid(
+                "world.speed",
+                u_mps,
+                "no approach speed on this world: its equations are written about their \
+                 design speed",
+            ));
+        }
+        // the revolutions found must hold the speed: no surge acceleration straight ahead
+        let ax = h.accel([u_mps, 0.0, 0.0], 0.0, [0.0; 3])[0];
+        if ax.is_nan() || ax.abs() > 1e-6 * u_mps {
+            return Err(SimError::invalid(
+                "world.speed",
+                u_mps,
+                "a speed some propeller revolutions hold on this hull",
+            ));
+        }
+        Ok(World {
+            speed: Some(u_mps),
+            ..self
+        })
+    }
+
+    /// The approach speed through the water straight ahead (m/s): the design speed unless
+    /// [`at_speed`](World::at_speed) set another.
+    pub fn approach_speed(&self) -> f64 {
+        match self.hull() {
+            Some(h) => h.u0(),
+            None => lng_reference().3,
+        }
     }
 
     /// Which world.
@@ -248,6 +328,16 @@ impl World {
     }
 
     fn hull(&self) -> Option<Box<dyn Hull>> {
+        let mut h = self.design_hull()?;
+        if let Some(u) = self.speed {
+            // checked by `at_speed`, the only way to set it
+            let _ = h.set_approach_speed(u);
+        }
+        Some(h)
+    }
+
+    /// The hull at its design speed.
+    fn design_hull(&self) -> Option<Box<dyn Hull>> {
         match self.kind {
             WorldKind::Lng => None,
             WorldKind::Kvlcc2 => Some(Box::new(mmg::Mmg::new(
@@ -274,9 +364,10 @@ impl World {
     /// assert_eq!(w.name(), "KVLCC2 (MMG, Lpp 320 m)");
     /// ```
     pub fn name(&self) -> String {
-        match self.hull() {
-            Some(h) => h.name(),
-            None => Ship::default_lng().name,
+        match (self.hull(), self.speed) {
+            (Some(h), Some(u)) => format!("{} at {u} m/s", h.name()),
+            (Some(h), None) => h.name(),
+            (None, _) => Ship::default_lng().name,
         }
     }
 
@@ -412,6 +503,15 @@ impl World {
             Some(h) => zigzag_hull(h.as_ref(), delta_deg, psi_deg),
         }
     }
+}
+
+/// `x` to three significant figures, for messages.
+fn sig3(x: f64) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    let p = 10f64.powi(2 - x.abs().log10().floor() as i32);
+    (x * p).round() / p
 }
 
 /// The built-in ship's `(L_pp, d, ρ, U)` (U its equilibrium speed).

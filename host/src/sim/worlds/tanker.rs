@@ -78,6 +78,8 @@ const N_CCBBD: f64 = 0.688;
 pub(crate) struct Tanker {
     /// Scale `λ` (1 at full scale).
     lambda: f64,
+    /// Approach speed at full scale (m/s).
+    u0_full: f64,
     /// Propeller revolutions at full scale (rev/s), held.
     n_p: f64,
     /// Extra rudder effectiveness to starboard (asymmetry effect).
@@ -89,19 +91,27 @@ impl Tanker {
     pub(crate) fn new(lpp: f64) -> Tanker {
         let mut h = Tanker {
             lambda: LPP_FULL / lpp,
+            u0_full: U0_FULL,
             n_p: 1.0,
             asym: 0.0,
         };
-        // revolutions for equilibrium on a straight course: the surge force rises with n
-        h.n_p = crate::sim::bisect(0.1, 10.0, 200, |n| {
+        h.hold(U0_FULL);
+        h
+    }
+
+    /// Sets the approach speed at full scale and the revolutions that hold it on a
+    /// straight course: the surge force rises with n.
+    fn hold(&mut self, u0_full: f64) {
+        self.u0_full = u0_full;
+        let h = self.clone();
+        self.n_p = crate::sim::bisect(0.1, 10.0, 200, |n| {
             Tanker {
                 n_p: n,
                 ..h.clone()
             }
-            .full([U0_FULL, 0.0, 0.0], 0.0, [0.0; 3])[0]
+            .full([u0_full, 0.0, 0.0], 0.0, [0.0; 3])[0]
                 > 0.0
         });
-        h
     }
 
     /// The propeller's revolutions at this scale (rev/s).
@@ -166,7 +176,7 @@ impl Hull for Tanker {
     }
 
     fn u0(&self) -> f64 {
-        U0_FULL / self.lambda.sqrt()
+        self.u0_full / self.lambda.sqrt()
     }
 
     fn froude_time(&self) -> f64 {
@@ -200,6 +210,11 @@ impl Hull for Tanker {
 
     fn set_asymmetry(&mut self, gain: f64) {
         self.asym = gain;
+    }
+
+    fn set_approach_speed(&mut self, u: f64) -> bool {
+        self.hold(u * self.lambda.sqrt());
+        true
     }
 
     fn accel(&self, s: [f64; 3], delta: f64, ext: [f64; 3]) -> [f64; 3] {

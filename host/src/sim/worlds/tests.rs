@@ -585,3 +585,53 @@ fn a_winds_moment_varies_with_heading_mostly_once_per_turn() {
         }
     }
 }
+
+#[test]
+fn a_world_sails_at_the_approach_speed_asked_on_the_revolutions_that_hold_it() {
+    for (kind, scale, u) in [
+        (WorldKind::EssoOsaka, Some(3.0), 0.3),
+        (WorldKind::Kvlcc2, None, 4.0),
+        (WorldKind::SeiunMaru, Some(4.0), 0.5),
+        (WorldKind::Container, None, 11.0),
+    ] {
+        let w = World::new(kind, scale).unwrap();
+        let s = w.at_speed(u).unwrap();
+        assert_eq!(s.approach_speed(), u);
+        assert!(s.name().ends_with(&format!(" at {u} m/s")), "{}", s.name());
+        // the same hull and sampling; its time L/U and the moment ½ρL²dU² follow the speed
+        assert_eq!(s.default_ts(), w.default_ts());
+        let ratio = w.approach_speed() / u;
+        assert!((s.time_ratio() / w.time_ratio() - ratio).abs() < 1e-12);
+        let moment = |w: &World| match w.hidden(EffectKind::Bias, 1.0) {
+            SimEffect::Bias { yaw_moment_nm } => yaw_moment_nm,
+            e => panic!("{e:?}"),
+        };
+        assert!((moment(&s) / moment(&w) * ratio * ratio - 1.0).abs() < 1e-9);
+        // straight ahead the propeller's thrust balances the resistance at the speed asked,
+        // and the balance is stable: slower, the ship gains speed; faster, it loses it
+        let h = s.hull().unwrap();
+        let surge = |x: f64| h.accel([x, 0.0, 0.0], 0.0, [0.0; 3])[0];
+        assert!(surge(u).abs() < 1e-9, "{}: {}", kind.name(), surge(u));
+        assert!(surge(0.95 * u) > 0.0 && surge(1.05 * u) < 0.0);
+    }
+    // what cannot be asked
+    let esso = World::new(WorldKind::EssoOsaka, None).unwrap();
+    for (w, u, says) in [
+        (
+            World::new(WorldKind::Mariner, None).unwrap(),
+            5.0,
+            "design speed",
+        ),
+        (World::new(WorldKind::Lng, None).unwrap(), 1.0, "ship file"),
+        (
+            esso,
+            1.0,
+            "0.25–1.5 times the world's design speed of 8.23 m/s",
+        ),
+        (esso, 13.0, "8.23 m/s"),
+        (esso, f64::NAN, "8.23 m/s"),
+    ] {
+        let e = w.at_speed(u).unwrap_err().to_string();
+        assert!(e.contains("world.speed") && e.contains(says), "{e}");
+    }
+}
