@@ -16,6 +16,8 @@ use crate::stats::chi2_sf;
 pub(super) struct AnemometerEvidence {
     /// Mean true wind, trial minus reference (north, east; m/s, the way it blows).
     pub(super) wind: [f64; 2],
+    /// The standard errors of `wind`'s components (m/s, block means).
+    pub(super) se: [f64; 2],
     /// Wald χ² (2 df).
     pub(super) chi: f64,
     /// Its p-value.
@@ -47,6 +49,26 @@ impl AnemometerEvidence {
         } else {
             self.p
         }
+    }
+
+    /// The standard error (m/s) of the true wind's speed: its components' along their mean
+    /// direction (the larger of the two where the mean is 0).
+    pub(super) fn speed_se(&self) -> f64 {
+        let ([n, e], [sn, se]) = (self.wind, self.se);
+        let norm = n.hypot(e);
+        if norm > 0.0 {
+            (n * sn).hypot(e * se) / norm
+        } else {
+            sn.max(se)
+        }
+    }
+
+    /// The smallest true wind (m/s, trials less reference) this test shows at `level`, in
+    /// the direction its mean is least certain: the instrument's floor plus that
+    /// component's standard error times the critical value of its χ² (2 df:
+    /// `√(−2 ln level)`). One that strong reaches the level about half the time.
+    pub(super) fn smallest(&self, level: f64) -> f64 {
+        self.floor + self.se[0].max(self.se[1]) * (-2.0 * level.ln()).max(0.0).sqrt()
     }
 
     /// Speed (m/s) and the direction it blows *from* (deg).
@@ -118,16 +140,60 @@ pub(super) fn anemometer_evidence(
     } else {
         0.0
     };
-    let mut chi = 0.0;
-    for k in 0..2 {
-        let se = t[k].1.hypot(r[k].1).max(1e-9);
-        chi += (shrink * wind[k] / se).powi(2);
-    }
+    let se = [0, 1].map(|k| t[k].1.hypot(r[k].1).max(1e-9));
+    let chi = (0..2).map(|k| (shrink * wind[k] / se[k]).powi(2)).sum();
     Some(AnemometerEvidence {
         wind,
+        se,
         chi,
         p: chi2_sf(chi, 2.0),
         floor,
         own,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Evidence of a mean true wind `wind` with component errors `se` over a floor.
+    fn evidence(wind: [f64; 2], se: [f64; 2], floor: f64) -> AnemometerEvidence {
+        let norm = wind[0].hypot(wind[1]);
+        let shrink = if norm > floor {
+            1.0 - floor / norm
+        } else {
+            0.0
+        };
+        let chi = (0..2).map(|k| (shrink * wind[k] / se[k]).powi(2)).sum();
+        AnemometerEvidence {
+            wind,
+            se,
+            chi,
+            p: chi2_sf(chi, 2.0),
+            floor,
+            own: [norm, 0.0],
+        }
+    }
+
+    #[test]
+    fn the_smallest_wind_shown_reaches_the_level_in_its_worst_direction() {
+        let (se, floor, level) = ([0.05, 0.2], 0.01, 1e-3);
+        let w = evidence([0.0; 2], se, floor).smallest(level);
+        // √(−2 ln 0.001) = 3.717: 0.01 + 0.2 × 3.717
+        assert!((w - 0.7534).abs() < 1e-4, "{w}");
+        // that wind along the worse component is just significant; along the better one,
+        // far more so; a little weaker along the worse, not
+        let p = |wind| evidence(wind, se, floor).p;
+        assert!(
+            (p([0.0, w]) - level).abs() < 1e-9 * level.max(1.0),
+            "{}",
+            p([0.0, w])
+        );
+        assert!(p([w, 0.0]) < 1e-12);
+        assert!(p([0.0, 0.9 * w]) > level);
+        // the speed's error: the components' along the mean direction
+        let e = evidence([0.3, 0.4], se, floor);
+        assert!((e.speed_se() - (0.3f64 * 0.05).hypot(0.4 * 0.2) / 0.5).abs() < 1e-12);
+        assert_eq!(e.speed_from().0, 0.5);
+    }
 }

@@ -140,6 +140,8 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
                     ev.score = ev.score.max(a.chi - 2.0);
                 }
                 ev.channel_material |= p_air < cfg.alpha / cfg_m(cfg);
+                ev.parameter = Some(speed);
+                ev.parameter_se = Some(a.speed_se());
                 ev.words.push_str(&format!(
                     "; the anemometer shows a true wind of {speed:.2} m/s from {from:.0}° \
                      (ground velocity less the apparent wind{}; beyond the instrument's \

@@ -231,7 +231,9 @@ pub struct Ranked {
     /// Held-out improvement on refit, or measurable channel evidence.
     pub material: bool,
     /// The effect's estimated structural parameter in physical units, where it has one
-    /// (dead time s, gear rate °/s, clip level °, gyro bias °/s, current m/s of speed over ground).
+    /// (dead time s, gear rate °/s, clip level °, gyro bias °/s, current m/s of speed over ground;
+    /// wind, where an anemometer is logged, the speed in m/s of the true wind it shows, trials
+    /// less reference).
     pub parameter: Option<f64>,
     /// How far off `parameter` may be, in its units: the standard error where a channel
     /// measures it (the gyro offset, from the heading), or for a value searched on a grid
@@ -244,9 +246,11 @@ pub struct Ranked {
     /// — one that size is significant about half the time: where the verdict is not this
     /// effect, a smaller one may be there unseen. Given for the effects of one gain judged
     /// on the yaw-rate errors (steady moment in ° of rudder/pod angle, asymmetry, nonlinear
-    /// damping, in `parameter`'s units), for the gyro offset on its heading channel (°/s)
-    /// and for the current on its ground track (m/s, in its worst direction); null for the
-    /// others (the grid-searched effects, wind) and where the records cannot give one.
+    /// damping, in `parameter`'s units), for the gyro offset on its heading channel (°/s),
+    /// for the current on its ground track (m/s, in its worst direction), for the wind on the
+    /// anemometer where one is logged (the true wind in m/s, in its worst direction) and else
+    /// as the amplitude (° of rudder/pod angle) of a yaw moment varying once per turn of
+    /// heading; null for the grid-searched effects and where the records cannot give one.
     pub resolution: Option<f64>,
     /// The evidence in words.
     pub evidence: String,
@@ -715,6 +719,10 @@ fn resolutions(
             match k {
                 EffectKind::GyroBias => ch.hb.map(|g| g.smallest(level)),
                 EffectKind::Current => ch.sog.as_ref().map(|s| s.smallest_current(at)),
+                // with an anemometer, the true wind it shows, as the wind's parameter is
+                EffectKind::Wind if ch.anemometer.is_some() => {
+                    ch.anemometer.map(|a| a.smallest(at))
+                }
                 _ if !ev[i].yaw_counted => None,
                 k if !crate::effects::def(k).gains.is_empty() => {
                     let d_crit = nulls[i].at(real[i].d).0.critical(at);
