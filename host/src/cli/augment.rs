@@ -415,7 +415,14 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
             estimated: rep.candidate.effect(kind).copied(),
             std_pct: rep.std_pct.clone(),
             reasons: rep.reasons.clone(),
-            explanation: rep.explanation.clone(),
+            explanation: format!(
+                "{}{}",
+                rep.explanation,
+                own_physics_note(
+                    auto && !rep.kept && !more.as_ref().is_some_and(|f| !f.added.is_empty()),
+                    what
+                )
+            ),
             out: ex.blob_path,
             ship: ship_written,
             sim_effect,
@@ -527,13 +534,7 @@ fn write_unchanged(
         ));
     }
     let searched = more.as_ref().is_some_and(|f| !f.added.is_empty());
-    // `augmented` with no effect kept: the ship's own physics the base carries
-    let own = if auto && what == Written::Augmented && !searched {
-        " The model written is `augmented` against the model given: it carries the ship's \
-         own physics the reference records show."
-    } else {
-        ""
-    };
+    let own = own_physics_note(auto && !searched, what);
     // (`--effect auto` always comes with `again`: without it, no effect was named)
     let explanation = match &again {
         Some(a) if a.kind.is_some() => format!("{}{own}", a.rep.explanation),
@@ -596,6 +597,18 @@ fn written_kind(given: &Model, written: &Model) -> Written {
         Written::Augmented
     } else {
         Written::Refit
+    }
+}
+
+/// The sentence that ends the explanation where `--effect auto` writes a model `augmented`
+/// against the model given with no effect kept (`none_kept`): the ship's own physics the
+/// reference records show, which the base carries ("" otherwise).
+fn own_physics_note(none_kept: bool, what: Written) -> &'static str {
+    if none_kept && what == Written::Augmented {
+        " The model written is `augmented` against the model given: it carries the ship's \
+         own physics the reference records show."
+    } else {
+        ""
     }
 }
 
