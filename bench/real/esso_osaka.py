@@ -24,8 +24,14 @@ What it does to each record, in this order:
    already filtered estimates, and the rudder holds its value between switches);
 5. converts: rudder angle rad -> deg, yaw rate rad/s -> deg/s, heading rad -> deg, relative wind
    direction rad -> deg (wrapped to [-180, 180)), speed = hypot(u, v_m) in m/s (the pond has no
-   current, so speed through the water is speed over ground);
-6. writes `t_s,delta_deg,r_degps,psi_deg,u_mps,wind_speed_mps,wind_angle_deg` with fixed decimals.
+   current, so speed through the water is speed over ground), course over ground = heading +
+   atan2(v_m, u) in deg (wrapped to [0, 360), the heading's frame);
+6. writes `t_s,delta_deg,r_degps,psi_deg,u_mps,wind_speed_mps,wind_angle_deg,cog_deg` with fixed
+   decimals;
+7. prints, per record, the mean of the source's own true wind (`wind_velo_true`,
+   `wind_dir_true`: the direction it comes from) over the rows kept, as a vector: speed and
+   direction, the figures PROVENANCE.md documents and host/tests/real.rs checks diagnose's
+   anemometer channel against.
 """
 
 import csv
@@ -45,7 +51,7 @@ DECIMATE = 4  # 10 Hz -> 2.5 Hz (Ts = 0.4 s)
 LEAD_S = 5.0  # kept before the first zig-zag switch
 SOURCE_TS = 0.1
 
-HEADER = "t_s,delta_deg,r_degps,psi_deg,u_mps,wind_speed_mps,wind_angle_deg"
+HEADER = "t_s,delta_deg,r_degps,psi_deg,u_mps,wind_speed_mps,wind_angle_deg,cog_deg"
 
 
 def read(path):
@@ -63,6 +69,8 @@ def read(path):
         "delta_rudder [rad]",
         "wind_velo_relative_mid [m/s]",
         "wind_dir_relative_mid [rad]",
+        "wind_velo_true [m/s]",
+        "wind_dir_true [rad]",
     ]
     out = []
     for r in rows[1:]:
@@ -101,12 +109,13 @@ def convert(src, dst, n_doc, amp_doc):
     data = crop(read(src), n_doc, amp_doc)
     t0 = data[0]["t [s]"]
     lines = [HEADER]
-    for k, d in enumerate(data[::DECIMATE]):
+    kept = data[::DECIMATE]
+    for k, d in enumerate(kept):
         t = round(d["t [s]"] - t0, 1)
         if abs(t - k * DECIMATE * SOURCE_TS) > 1e-6:
             raise SystemExit(f"{src}: time stamps are not uniform at row {k}")
         lines.append(
-            "{:.1f},{:.3f},{:.4f},{:.3f},{:.4f},{:.3f},{:.2f}".format(
+            "{:.1f},{:.3f},{:.4f},{:.3f},{:.4f},{:.3f},{:.2f},{:.2f}".format(
                 t,
                 math.degrees(d["delta_rudder [rad]"]),
                 math.degrees(d["r_angvelo [rad/s]"]),
@@ -114,11 +123,18 @@ def convert(src, dst, n_doc, amp_doc):
                 math.hypot(d["u_velo [m/s]"], d["vm_velo [m/s]"]),
                 d["wind_velo_relative_mid [m/s]"],
                 wrap180(math.degrees(d["wind_dir_relative_mid [rad]"])),
+                (
+                    math.degrees(d["psi_hat [rad]"] + math.atan2(d["vm_velo [m/s]"], d["u_velo [m/s]"]))
+                    % 360.0
+                ),
             )
         )
     with open(dst, "w", newline="\n") as f:
         f.write("\n".join(lines) + "\n")
-    return len(lines) - 1
+    # the source's true wind, averaged as a vector (x0, y0: the direction it blows towards)
+    wx = sum(-d["wind_velo_true [m/s]"] * math.cos(d["wind_dir_true [rad]"]) for d in kept) / len(kept)
+    wy = sum(-d["wind_velo_true [m/s]"] * math.sin(d["wind_dir_true [rad]"]) for d in kept) / len(kept)
+    return len(lines) - 1, (wx, wy)
 
 
 def main():
@@ -132,9 +148,21 @@ def main():
         else os.path.join(here, "..", "..", "tests", "data", "real", "esso_osaka")
     )
     os.makedirs(out_dir, exist_ok=True)
+    total = [0.0, 0.0, 0]
     for src, dst, n_doc, amp_doc in RECORDS:
-        n = convert(os.path.join(src_dir, src), os.path.join(out_dir, dst), n_doc, amp_doc)
-        print(f"{src} -> {dst}: {n} rows")
+        n, (wx, wy) = convert(os.path.join(src_dir, src), os.path.join(out_dir, dst), n_doc, amp_doc)
+        total[0] += wx * n
+        total[1] += wy * n
+        total[2] += n
+        print(
+            f"{src} -> {dst}: {n} rows; the source's true wind {math.hypot(wx, wy):.3f} m/s "
+            f"from {math.degrees(math.atan2(-wy, -wx)) % 360.0:.1f} deg (mean vector)"
+        )
+    wx, wy = total[0] / total[2], total[1] / total[2]
+    print(
+        f"all records: the source's true wind {math.hypot(wx, wy):.3f} m/s "
+        f"from {math.degrees(math.atan2(-wy, -wx)) % 360.0:.1f} deg (mean vector, rows weighted alike)"
+    )
 
 
 if __name__ == "__main__":
