@@ -19,6 +19,16 @@ fn scratch(name: &str) -> PathBuf {
     d
 }
 
+/// Line `k` of a CSV text (0: the header), its fields as numbers.
+fn row(csv: &str, k: usize) -> Vec<f64> {
+    csv.lines()
+        .nth(k)
+        .unwrap()
+        .split(',')
+        .map(|x| x.parse().unwrap())
+        .collect()
+}
+
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -68,13 +78,7 @@ fn kvlcc2_writes_the_usual_columns_seeded() {
     assert_ne!(a.lines().nth(50), c.lines().nth(50));
     // Froude-scaled to the 7 m model: Ts √(7/320) s, speed 1.18 m/s
     let m = simulate(&d, "m.csv", &["--world", "kvlcc2", "--scale", "7"]);
-    let r: Vec<f64> = m
-        .lines()
-        .nth(2)
-        .unwrap()
-        .split(',')
-        .map(|x| x.parse().unwrap())
-        .collect();
+    let r = row(&m, 2);
     assert!((r[0] - (7.0f64 / 320.0).sqrt()).abs() < 1e-6, "{r:?}");
     assert!((1.0..1.4).contains(&r[4]), "{r:?}");
     // the same model at the approach speed asked: its speed over ground starts there
@@ -93,13 +97,7 @@ fn kvlcc2_writes_the_usual_columns_seeded() {
             js.to_str().unwrap(),
         ],
     );
-    let r: Vec<f64> = slow
-        .lines()
-        .nth(1)
-        .unwrap()
-        .split(',')
-        .map(|x| x.parse().unwrap())
-        .collect();
+    let r = row(&slow, 1);
     assert!((0.55..0.65).contains(&r[4]), "{r:?}");
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&js).unwrap()).unwrap();
