@@ -165,7 +165,7 @@ fn ship_files_and_scales_belong_to_their_worlds() {
     for (world, speed, says) in [
         ("mariner", "5", "design speed"),
         ("esso-osaka", "20", "design speed of 8.23 m/s"),
-        ("lng", "1", "ship file"),
+        ("lng", "1", "`rps` under `[pods]`"),
     ] {
         let o = run(&["simulate", "--world", world, "--speed", speed, "--out", out]);
         assert_eq!(o.status.code(), Some(2));

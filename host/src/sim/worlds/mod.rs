@@ -258,7 +258,7 @@ impl World {
     /// follows. For records of a ship that ran slower or faster than the source's design
     /// speed — tank tests often do. KVLCC2, the Seiun Maru, the container ship and the Esso
     /// Osaka only: the Mariner's equations are written about their design speed, and the
-    /// built-in ship's speed is its ship file's.
+    /// built-in ship's speed is its pods' revolutions (`rps` in a ship file).
     ///
     /// ```
     /// use yawcast::sim::{World, WorldKind};
@@ -276,7 +276,8 @@ impl World {
             return Err(SimError::invalid(
                 "world.speed",
                 u_mps,
-                "no approach speed on the built-in ship: set its ship file's",
+                "no approach speed on the built-in ship: its speed is its pods' revolutions, `rps` \
+                 under `[pods]` in a ship file (--ship)",
             ));
         };
         let design = h.u0();
