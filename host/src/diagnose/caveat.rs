@@ -256,10 +256,12 @@ impl Caveat {
                  and the speed lost in turns): a hull's rudder gain and time constants change \
                  with speed, and the library's effects can only mimic that, so an angle limit, \
                  a dead band, an asymmetry or damping named here may be the speed. Sail the \
-                 reference at the trials' speed (in a ship file, the propeller revolutions).",
+                 reference at the trials' speed (in a ship file, the propeller revolutions; on \
+                 a test world, `simulate --speed {}`).",
                 sig(*trials_mps),
                 sig(*reference_mps),
-                100.0 * (trials_mps / reference_mps - 1.0)
+                100.0 * (trials_mps / reference_mps - 1.0),
+                sig(*trials_mps)
             ),
             Caveat::NoReference => "No reference records were given, so every statistic is \
                 judged against the model alone: hull nonlinearity the model never had shows up \

@@ -723,6 +723,11 @@ mod tests {
         // where a current as large could not be told apart
         let c = crate::diagnose::caveat::other_speed(Some([slow, u]), 0.1).unwrap();
         assert!(c.explain().contains("(-20 %"), "{}", c.explain());
+        assert!(
+            c.explain().contains("`simulate --speed 3.99`"),
+            "{}",
+            c.explain()
+        );
         assert_eq!(
             crate::diagnose::caveat::other_speed(Some([4.8, 5.0]), 0.1),
             None
