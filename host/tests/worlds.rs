@@ -164,7 +164,7 @@ fn ship_files_and_scales_belong_to_their_worlds() {
     // within 0.25–1.5 times a world's design speed, which the message gives
     for (world, speed, says) in [
         ("mariner", "5", "design speed"),
-        ("esso-osaka", "20", "design speed of 8.23 m/s"),
+        ("esso-osaka", "20", "design speed of 8.230 m/s"),
         ("lng", "1", "`rps` under `[pods]`"),
     ] {
         let o = run(&["simulate", "--world", world, "--speed", speed, "--out", out]);

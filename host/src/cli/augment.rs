@@ -324,6 +324,7 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
     let more = search_more(args, &rep.model, &est, &val, then, &cfg)?;
     let written = more.as_ref().map_or(&rep.model, |f| &f.model);
     let what = written_kind(&given, written);
+    let searched = more.as_ref().is_some_and(|f| !f.added.is_empty());
 
     let check = val
         .first()
@@ -418,10 +419,7 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
             explanation: format!(
                 "{}{}",
                 rep.explanation,
-                own_physics_note(
-                    auto && !rep.kept && !more.as_ref().is_some_and(|f| !f.added.is_empty()),
-                    what
-                )
+                own_physics_note(auto && !rep.kept && !searched, what)
             ),
             out: ex.blob_path,
             ship: ship_written,

@@ -285,10 +285,7 @@ impl World {
             return Err(SimError::invalid(
                 "world.speed",
                 u_mps,
-                &format!(
-                    "0.25–1.5 times the world's design speed of {} m/s at its scale",
-                    sig3(design)
-                ),
+                &format!("0.25–1.5 times the world's design speed of {design:.3} m/s at its scale"),
             ));
         }
         if !h.set_approach_speed(u_mps) {
@@ -504,15 +501,6 @@ impl World {
             Some(h) => zigzag_hull(h.as_ref(), delta_deg, psi_deg),
         }
     }
-}
-
-/// `x` to three significant figures, for messages.
-fn sig3(x: f64) -> f64 {
-    if x == 0.0 || !x.is_finite() {
-        return x;
-    }
-    let p = 10f64.powi(2 - x.abs().log10().floor() as i32);
-    (x * p).round() / p
 }
 
 /// The built-in ship's `(L_pp, d, ρ, U)` (U its equilibrium speed).

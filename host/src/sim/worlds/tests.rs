@@ -626,10 +626,10 @@ fn a_world_sails_at_the_approach_speed_asked_on_the_revolutions_that_hold_it() {
         (
             esso,
             1.0,
-            "0.25–1.5 times the world's design speed of 8.23 m/s",
+            "0.25–1.5 times the world's design speed of 8.230 m/s",
         ),
-        (esso, 13.0, "8.23 m/s"),
-        (esso, f64::NAN, "8.23 m/s"),
+        (esso, 13.0, "8.230 m/s"),
+        (esso, f64::NAN, "8.230 m/s"),
     ] {
         let e = w.at_speed(u).unwrap_err().to_string();
         assert!(e.contains("world.speed") && e.contains(says), "{e}");
