@@ -313,17 +313,9 @@ fn true_wind_words(evidence: &str) -> (f64, f64) {
         .split("the anemometer shows a true wind of ")
         .nth(1)
         .unwrap_or_else(|| panic!("no true wind in {evidence}"));
-    let speed: f64 = rest.split(" m/s from ").next().unwrap().parse().unwrap();
-    let from: f64 = rest
-        .split(" m/s from ")
-        .nth(1)
-        .unwrap()
-        .split('°')
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
-    (speed, from)
+    let (speed, rest) = rest.split_once(" m/s from ").unwrap();
+    let from = rest.split('°').next().unwrap();
+    (speed.parse().unwrap(), from.parse().unwrap())
 }
 
 #[test]
