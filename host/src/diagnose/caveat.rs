@@ -155,18 +155,42 @@ pub enum Caveat {
         /// (each in words; empty when the reference shows none).
         hull: Vec<String>,
     },
-    /// The trials ran at another speed through the water than the reference, by
-    /// [`OTHER_SPEED`] or more of the reference's, and by more than the smallest current the
-    /// ground track can show ([`Caveat::CurrentResolution`]): a hull's rudder gain and time
-    /// constants change with speed, which the library's effects can only mimic. Given only
+    /// The trials ran at another speed than the reference, by [`OTHER_SPEED`] or more of
+    /// the reference's: a hull's rudder gain and time constants change with speed through
+    /// the water, which the library's effects can only mimic. Either the difference exceeds
+    /// the smallest current the ground track can show ([`Caveat::CurrentResolution`]), so it
+    /// is the speed through the water; or it does not — records that each hold one course
+    /// cannot tell a current along it from the speed — and the caveat says both. Given only
     /// for trials sailed with commands like the reference's (no
     /// [`Caveat::OtherManoeuvre`]): a zig-zag's straight speed is an extrapolation.
     OtherSpeed {
-        /// The trials' speed straight ahead through the water (m/s): speed over ground less
-        /// the current its heading harmonics show and the speed lost in turns.
+        /// The trials' speed straight ahead (m/s): through the water where
+        /// `told_from_current` (speed over ground less the current its heading harmonics
+        /// show and the speed lost in turns), else over the ground on their courses (less
+        /// the speed lost in turns only).
         trials_mps: f64,
-        /// The reference's (m/s).
+        /// The reference's (m/s), read the same way.
         reference_mps: f64,
+        /// Whether the ground track tells the difference from a current: `false` where a
+        /// current along the courses sailed as large as the difference could not be told.
+        told_from_current: bool,
+    },
+    /// The trials ran at another speed over the ground ([`Caveat::OtherSpeed`]); the
+    /// reference re-timed to theirs by similarity (time divided by `ratio`, yaw rate and
+    /// speeds times it: a hull's manoeuvres at another speed are the same in distance
+    /// sailed) and the model re-identified on it predict the trials 10 steps ahead by 1 pp
+    /// or more better than the model given (`shows_speed`: the hull answers the helm as at
+    /// the trials' speed, so the difference is the speed through the water), or not (more
+    /// likely a current along the courses, which changes the speed over the ground only).
+    SpeedSimilar {
+        /// The trials' speed over the reference's.
+        ratio: f64,
+        /// The model given: 10-step fit (%) on the trials.
+        fit_10_given_pct: f64,
+        /// The model re-identified on the re-timed reference: 10-step fit (%) on the trials.
+        fit_10_similar_pct: f64,
+        /// Whether it predicts them 1 pp or more better: the speed through the water differs.
+        shows_speed: bool,
     },
     /// The reference records show more of a current or wind than the trials — their own
     /// heading harmonics of the ground velocity, or the anemometer's true wind, the larger —
@@ -250,19 +274,70 @@ impl Caveat {
             Caveat::OtherSpeed {
                 trials_mps,
                 reference_mps,
-            } => format!(
-                "The trials ran straight at {} m/s through the water and the reference at {} \
-                 m/s ({:+.0} %; speed over ground less the current its heading harmonics show \
-                 and the speed lost in turns): a hull's rudder gain and time constants change \
-                 with speed, and the library's effects can only mimic that, so an angle limit, \
-                 a dead band, an asymmetry or damping named here may be the speed. Sail the \
-                 reference at the trials' speed (in a ship file, the propeller revolutions; on \
-                 a test world, `simulate --speed {}`).",
-                sig(*trials_mps),
-                sig(*reference_mps),
-                100.0 * (trials_mps / reference_mps - 1.0),
-                sig(*trials_mps)
-            ),
+                told_from_current,
+            } => {
+                let pct = 100.0 * (trials_mps / reference_mps - 1.0);
+                let (t, r) = (sig(*trials_mps), sig(*reference_mps));
+                let speed = "a hull's rudder gain and time constants change with speed, and \
+                    the library's effects can only mimic that, so an angle limit, a dead band, \
+                    an asymmetry or damping named here may be the speed";
+                let remedy = format!(
+                    "Sail the reference at the trials' speed (in a ship file, the propeller \
+                     revolutions; on a test world, `simulate --speed {t}`)"
+                );
+                if *told_from_current {
+                    format!(
+                        "The trials ran straight at {t} m/s through the water and the \
+                         reference at {r} m/s ({pct:+.0} %; speed over ground less the \
+                         current its heading harmonics show and the speed lost in turns): \
+                         {speed}. {remedy}."
+                    )
+                } else {
+                    format!(
+                        "The trials ran straight at {t} m/s over the ground on their courses \
+                         and the reference at {r} m/s ({pct:+.0} %; less the speed lost in \
+                         turns). The ground track cannot tell which: another speed through \
+                         the water, or a current of about {} m/s along the courses the \
+                         trials held. If the speed, {speed}. {remedy}; if the trials sailed \
+                         at the reference's speed through the water, the difference is a \
+                         current.",
+                        sig((trials_mps - reference_mps).abs())
+                    )
+                }
+            }
+            Caveat::SpeedSimilar {
+                ratio,
+                fit_10_given_pct,
+                fit_10_similar_pct,
+                shows_speed,
+            } => {
+                let what = format!(
+                    "The reference re-timed to the trials' speed by similarity (×{}: a hull's \
+                     manoeuvres at another speed are the same in distance sailed, so time is \
+                     divided by that and yaw rate and speeds multiplied) and the model \
+                     re-identified on it predict the trials 10 steps ahead at {:.1} % against \
+                     {:.1} % for the model given",
+                    sig(*ratio),
+                    fit_10_similar_pct,
+                    fit_10_given_pct
+                );
+                if *shows_speed {
+                    format!(
+                        "{what}: the hull answers the helm as at the trials' speed, which a \
+                         current would not change, so the trials ran at another speed through \
+                         the water. The statistics stay measured against the model given: \
+                         the re-timed records also scale the steering gear's rate and dead \
+                         time, which a real gear keeps, so they cannot stand in for a \
+                         reference sailed at the trials' speed."
+                    )
+                } else {
+                    format!(
+                        "{what}: no better by {GAIN_PP} pp, so the difference is more likely a \
+                         current along the courses, which changes the speed over the ground \
+                         and not how the hull answers the helm."
+                    )
+                }
+            }
             Caveat::NoReference => "No reference records were given, so every statistic is \
                 judged against the model alone: hull nonlinearity the model never had shows up \
                 as an effect, and the verdict is weaker."
@@ -515,15 +590,29 @@ pub(super) fn caveats(
 pub const OTHER_SPEED: f64 = 0.15;
 
 /// [`Caveat::OtherSpeed`] for the speeds `[trials, reference]` when they differ by
-/// [`OTHER_SPEED`] or more, and by more than `resolution` (m/s), the smallest current the
-/// ground track shows (so a current it cannot separate from the speed is not read as one).
-pub(super) fn other_speed(speeds: Option<[f64; 2]>, resolution: f64) -> Option<Caveat> {
-    let [t, r] = speeds?;
-    let differ = r > 0.0 && (t / r - 1.0).abs() >= OTHER_SPEED && (t - r).abs() > resolution;
-    differ.then_some(Caveat::OtherSpeed {
+/// [`OTHER_SPEED`] or more: through the water (`speeds`, [`super::channels::straight_speed`])
+/// where they differ by more than `resolution` (m/s), the smallest current the ground track
+/// shows; else over the ground on the courses sailed (`course`,
+/// [`super::channels::course_speed`]) where those differ by no more than it, saying that a
+/// current along the courses could be the difference.
+pub(super) fn other_speed(
+    speeds: Option<[f64; 2]>,
+    course: Option<[f64; 2]>,
+    resolution: f64,
+) -> Option<Caveat> {
+    let differ = |s: &[f64; 2]| s[1] > 0.0 && (s[0] / s[1] - 1.0).abs() >= OTHER_SPEED;
+    let told = |s: &[f64; 2]| (s[0] - s[1]).abs() > resolution;
+    let caveat = |[t, r]: [f64; 2], told_from_current| Caveat::OtherSpeed {
         trials_mps: t,
         reference_mps: r,
-    })
+        told_from_current,
+    };
+    match speeds.filter(|s| differ(s) && told(s)) {
+        Some(s) => Some(caveat(s, true)),
+        None => course
+            .filter(|s| differ(s) && !told(s))
+            .map(|s| caveat(s, false)),
+    }
 }
 
 /// The sample time [`Caveat::Blocks`] suggests for `sets` (trials, reference, held-out):

@@ -32,6 +32,9 @@ pub(super) struct Channels {
     /// The speed through the water straight ahead of the trials and of the reference
     /// ([`straight_speed`]), when both log heading and speed.
     pub(super) speeds: Option<[f64; 2]>,
+    /// The same over the ground on the courses sailed ([`course_speed`]): what records
+    /// that each hold one course show.
+    pub(super) course_speeds: Option<[f64; 2]>,
     /// The trials' [`heading_separation`], when every trial logs its heading.
     pub(super) separation: Option<f64>,
 }
@@ -65,13 +68,14 @@ impl Channels {
         } else {
             None
         };
-        let speeds = if speed_ok && has_ref {
-            straight_speed(est)
-                .zip(straight_speed(reference))
-                .map(|(t, r)| [t, r])
-        } else {
-            None
+        let both = |f: fn(&[Record]) -> Option<f64>| {
+            if speed_ok && has_ref {
+                f(est).zip(f(reference)).map(|(t, r)| [t, r])
+            } else {
+                None
+            }
         };
+        let (speeds, course_speeds) = (both(straight_speed), both(course_speed));
         Channels {
             heading_ok,
             speed_ok,
@@ -79,6 +83,7 @@ impl Channels {
             sog,
             anemometer,
             speeds,
+            course_speeds,
             separation,
         }
     }
@@ -121,8 +126,29 @@ fn sog_harmonics(beta: DVector<f64>, records: usize) -> DVector<f64> {
 /// ground less the current its heading harmonics take, less the speed lost in turns and to
 /// the commands. `None` without heading or speed, or where the fit cannot be made.
 pub(super) fn straight_speed(recs: &[Record]) -> Option<f64> {
+    intercept_speed(recs, true)
+}
+
+/// The speed a set of records runs at straight ahead over the ground on the courses they
+/// sailed (m/s): as [`straight_speed`] without the heading harmonics, so whatever a current
+/// adds along those courses stays in it. On records that each hold one course the
+/// harmonics are each record's own offset, and [`straight_speed`] splits the speed between
+/// them as its ridge happens to; this figure is what such records show.
+pub(super) fn course_speed(recs: &[Record]) -> Option<f64> {
+    intercept_speed(recs, false)
+}
+
+/// The mean per-record intercept of the [`sog_fit`] along the heading, with or without the
+/// heading harmonics (without: their columns are zero, and the fit's ridge holds their
+/// coefficients at zero).
+fn intercept_speed(recs: &[Record], harmonics: bool) -> Option<f64> {
     let refs: Vec<&Record> = recs.iter().collect();
-    let heading = headings(&refs)?;
+    let mut heading = headings(&refs)?;
+    if !harmonics {
+        heading
+            .iter_mut()
+            .for_each(|h| h.harmonics.iter_mut().for_each(|x| *x = [0.0; 4]));
+    }
     let taus = sog_taus(refs.iter().copied());
     let beta = sog_fit(Lane::Along, &refs, &heading, &[], &taus, None)?;
     let u = beta.rows(0, refs.len()).mean();
@@ -666,6 +692,8 @@ fn largest_eigenvalue(a: f64, b: f64, c: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::diagnose::augment::sig;
+    use crate::diagnose::caveat::Caveat;
     use crate::sim::{simulate_with_nav, InputSpec, NoiseSpec, Scenario, Ship};
 
     #[test]
@@ -721,7 +749,7 @@ mod tests {
         assert!((slow - 4.0).abs() < 0.05, "{slow}");
         // 20 % slower is told (the ground track resolves 0.1 m/s), 5 % is not, nor 20 %
         // where a current as large could not be told apart
-        let c = crate::diagnose::caveat::other_speed(Some([slow, u]), 0.1).unwrap();
+        let c = crate::diagnose::caveat::other_speed(Some([slow, u]), None, 0.1).unwrap();
         assert!(c.explain().contains("(-20 %"), "{}", c.explain());
         assert!(
             c.explain().contains("`simulate --speed 3.99`"),
@@ -729,11 +757,11 @@ mod tests {
             c.explain()
         );
         assert_eq!(
-            crate::diagnose::caveat::other_speed(Some([4.8, 5.0]), 0.1),
+            crate::diagnose::caveat::other_speed(Some([4.8, 5.0]), None, 0.1),
             None
         );
         assert_eq!(
-            crate::diagnose::caveat::other_speed(Some([slow, u]), 1.5),
+            crate::diagnose::caveat::other_speed(Some([slow, u]), None, 1.5),
             None
         );
         // no heading, no speed
@@ -746,6 +774,11 @@ mod tests {
     /// --trial-input zigzag:20/20 --ref-input zigzag:20/20` sails them (with `trial` the
     /// trials' noise, else the reference's).
     fn zigzags(seeds: &[u64], trial: bool) -> Vec<Record> {
+        zigzags_of(&Ship::default_lng(), seeds, trial)
+    }
+
+    /// [`zigzags`] of `ship`.
+    fn zigzags_of(ship: &Ship, seeds: &[u64], trial: bool) -> Vec<Record> {
         let sc = Scenario {
             input: InputSpec::ZigZag {
                 delta_deg: 20.0,
@@ -763,7 +796,7 @@ mod tests {
         seeds
             .iter()
             .map(|&s| {
-                let (mut r, nav) = simulate_with_nav(&Ship::default_lng(), &sc, s).unwrap();
+                let (mut r, nav) = simulate_with_nav(ship, &sc, s).unwrap();
                 r.cog = Some(nav.cog_deg);
                 r
             })
@@ -790,5 +823,56 @@ mod tests {
         assert!(p > 0.05, "{s:?}");
         // nor wind's harmonics
         assert!(s.test(false).2 > level, "{s:?}");
+    }
+
+    #[test]
+    fn zig_zags_at_another_speed_show_it_over_the_ground_on_their_courses() {
+        // one-course zig-zags of the built-in ship, its pods at 10.5 rev/s (the reference,
+        // and trials with other noise and headings) and at 8.0 (slower trials)
+        let reference = zigzags(&[900, 901, 902], false);
+        let same = zigzags(&[100, 101, 102], true);
+        let mut ship = Ship::default_lng();
+        ship.pods.rps = 8.0;
+        let slow = zigzags_of(&ship, &[100, 101, 102], true);
+        let [r, t, s] = [&reference, &same, &slow].map(|x| course_speed(x).unwrap());
+        println!("course speed: reference {r:.3}, trials {t:.3}, slower trials {s:.3} m/s");
+        assert!((t / r - 1.0).abs() < 0.03, "{t} {r}");
+        assert!((s / r - 1.0) < -0.2, "{s} {r}");
+        // their ground track cannot resolve a current as large (here: from 1 m/s on), so
+        // the caveat says both readings; the same speed gives none
+        let c = crate::diagnose::caveat::other_speed(None, Some([s, r]), 1.0).unwrap();
+        let words = c.explain();
+        assert!(
+            matches!(
+                c,
+                Caveat::OtherSpeed {
+                    told_from_current: false,
+                    ..
+                }
+            ),
+            "{c:?}"
+        );
+        assert!(
+            words.contains("over the ground on their courses"),
+            "{words}"
+        );
+        assert!(
+            words.contains(&format!("a current of about {} m/s", sig(r - s))),
+            "{words}"
+        );
+        assert!(
+            words.contains(&format!("`simulate --speed {}`", sig(s))),
+            "{words}"
+        );
+        assert_eq!(
+            crate::diagnose::caveat::other_speed(None, Some([t, r]), 1.0),
+            None
+        );
+        // a difference the ground track does resolve is left to the speed through the
+        // water: none here, as none was given
+        assert_eq!(
+            crate::diagnose::caveat::other_speed(None, Some([s, r]), 0.1),
+            None
+        );
     }
 }

@@ -110,6 +110,7 @@ pub mod resid;
 mod rule;
 mod second;
 mod separation;
+mod similar;
 #[cfg(test)]
 pub(crate) mod tests;
 mod verdict;
@@ -340,9 +341,38 @@ pub enum DiagnoseError {
 /// assert_eq!(e.to_string(), "no trial records given");
 /// ```
 ///
+/// Where the trials ran at another speed than the reference ([`Caveat::OtherSpeed`]), the
+/// reference re-timed to the trials' speed by similarity tells the speed through the water
+/// from a current along the courses ([`Caveat::SpeedSimilar`]).
+pub fn diagnose(
+    model: &Model,
+    reference: &[Record],
+    est: &[Record],
+    val: &[Record],
+    cfg: &DiagnoseConfig,
+) -> Result<Diagnosis, DiagnoseError> {
+    let mut d = diagnose_once(model, reference, est, val, cfg)?;
+    let ratio = d.caveats.iter().find_map(|c| match c {
+        Caveat::OtherSpeed {
+            trials_mps,
+            reference_mps,
+            ..
+        } => Some(trials_mps / reference_mps),
+        _ => None,
+    });
+    if let Some(c) = ratio.and_then(|s| similar::at_trials_speed(s, model, reference, est)) {
+        d.explanation.push(' ');
+        d.explanation.push_str(&c.explain());
+        d.caveats.push(c);
+    }
+    Ok(d)
+}
+
+/// One diagnosis of `model` on `est` against `reference` ([`diagnose`]).
+///
 /// Long: the driver: the method's steps in the order the module docs give them, each a call to
 /// its own module.
-pub fn diagnose(
+fn diagnose_once(
     model: &Model,
     reference: &[Record],
     est: &[Record],
@@ -584,7 +614,7 @@ pub fn diagnose(
     // is an extrapolation to a rudder held amidships, which the records never show
     // (effect-free zig-zags against a PRBS reference read 3.7 m/s against 7.7 on Mariner)
     if other.is_none() {
-        caveats.extend(caveat::other_speed(ch.speeds, resolution));
+        caveats.extend(caveat::other_speed(ch.speeds, ch.course_speeds, resolution));
     }
     caveats.extend(caveat::reference_environment(&ch, level));
     if let Some(x) = current_resolution.filter(|_| verdict_name != EffectKind::Current.name()) {
