@@ -407,12 +407,7 @@ fn against_a_simulator_of_the_hull_the_trials_show_the_wind_the_pond_measured() 
             "seed {seed}: then {}",
             d["then"]
         );
-        let wind = d["ranking"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|r| r["effect"] == "wind")
-            .unwrap();
+        let wind = ranked(&d, "wind");
         assert_eq!(wind["significant"], true, "{wind}");
         assert_eq!(wind["material"], true, "{wind}");
         // The true wind the anemometer channel reads (ground velocity less the apparent
@@ -463,6 +458,16 @@ fn against_a_simulator_of_the_hull_the_trials_show_the_wind_the_pond_measured() 
         a["explanation"]
     );
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The row of `effect` in a diagnosis' ranking.
+fn ranked<'a>(d: &'a Value, effect: &str) -> &'a Value {
+    d["ranking"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["effect"] == effect)
+        .unwrap_or_else(|| panic!("no {effect} ranked: {}", d["ranking"]))
 }
 
 /// The `other-speed` caveat of a diagnosis, if it has one.
@@ -524,12 +529,7 @@ fn against_a_simulator_at_its_design_speed_the_trials_other_speed_is_told_from_a
         "{words}"
     );
     // the wind the anemometer shows does not depend on the reference's speed: the source's
-    let wind = d["ranking"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|r| r["effect"] == "wind")
-        .unwrap();
+    let wind = ranked(&d, "wind");
     assert_eq!(wind["significant"], true, "{wind}");
     let speed = wind["parameter"].as_f64().unwrap();
     assert!((speed - SOURCE_TRUE_WIND.0).abs() < 0.02, "{speed} m/s");

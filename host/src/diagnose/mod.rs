@@ -344,35 +344,10 @@ pub enum DiagnoseError {
 /// Where the trials ran at another speed than the reference ([`Caveat::OtherSpeed`]), the
 /// reference re-timed to the trials' speed by similarity tells the speed through the water
 /// from a current along the courses ([`Caveat::SpeedSimilar`]).
-pub fn diagnose(
-    model: &Model,
-    reference: &[Record],
-    est: &[Record],
-    val: &[Record],
-    cfg: &DiagnoseConfig,
-) -> Result<Diagnosis, DiagnoseError> {
-    let mut d = diagnose_once(model, reference, est, val, cfg)?;
-    let ratio = d.caveats.iter().find_map(|c| match c {
-        Caveat::OtherSpeed {
-            trials_mps,
-            reference_mps,
-            ..
-        } => Some(trials_mps / reference_mps),
-        _ => None,
-    });
-    if let Some(c) = ratio.and_then(|s| similar::at_trials_speed(s, model, reference, est)) {
-        d.explanation.push(' ');
-        d.explanation.push_str(&c.explain());
-        d.caveats.push(c);
-    }
-    Ok(d)
-}
-
-/// One diagnosis of `model` on `est` against `reference` ([`diagnose`]).
 ///
 /// Long: the driver: the method's steps in the order the module docs give them, each a call to
 /// its own module.
-fn diagnose_once(
+pub fn diagnose(
     model: &Model,
     reference: &[Record],
     est: &[Record],
@@ -616,6 +591,16 @@ fn diagnose_once(
     if other.is_none() {
         caveats.extend(caveat::other_speed(ch.speeds, ch.course_speeds, resolution));
     }
+    // speed or current: the reference re-timed to the trials' speed, on the records whole
+    let ratio = caveats.iter().find_map(|c| match c {
+        Caveat::OtherSpeed {
+            trials_mps,
+            reference_mps,
+            ..
+        } => Some(trials_mps / reference_mps),
+        _ => None,
+    });
+    caveats.extend(ratio.and_then(|s| similar::at_trials_speed(s, model, given[1], given[0])));
     caveats.extend(caveat::reference_environment(&ch, level));
     if let Some(x) = current_resolution.filter(|_| verdict_name != EffectKind::Current.name()) {
         caveats.push(Caveat::CurrentResolution { smallest_mps: x });
