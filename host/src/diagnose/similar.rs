@@ -19,10 +19,11 @@
 //! (docs/method.md), so the statistics stay measured against the reference as given.
 
 use super::caveat::Caveat;
+use super::compare::mean_fit;
 use super::rule::GAIN_PP;
 use crate::identify::model::Model;
 use crate::identify::pem::{self, PemConfig};
-use crate::identify::predict::{fit_at, Horizon};
+use crate::identify::predict::Horizon;
 use crate::io::data::Record;
 
 /// Speed ratios (trials over reference) outside which the reference is not re-timed: a
@@ -85,14 +86,6 @@ pub(super) fn retime(rec: &Record, s: f64) -> Option<Record> {
     })
 }
 
-/// The mean fit (%) of `model` on `recs` 10 steps ahead.
-fn fit_10(model: &Model, recs: &[Record]) -> f64 {
-    recs.iter()
-        .map(|r| fit_at(model, r, Horizon::Steps(10)))
-        .sum::<f64>()
-        / recs.len().max(1) as f64
-}
-
 /// [`Caveat::SpeedSimilar`]: the reference re-timed to the trials' speed ([`retime`] by
 /// `ratio`, the trials' speed over the reference's), `model` re-identified on it (its
 /// structure kept), and whether that predicts the trials `est` 10 steps ahead by [`GAIN_PP`]
@@ -118,7 +111,8 @@ pub(super) fn at_trials_speed(
         ..PemConfig::default()
     };
     let similar = pem::identify_from(&retimed, model, &pc).ok()?.model;
-    let (given, at_speed) = (fit_10(model, est), fit_10(&similar, est));
+    let fit_10 = |m: &Model| mean_fit(m, est, &[Horizon::Steps(10)])[&Horizon::Steps(10).key()];
+    let (given, at_speed) = (fit_10(model), fit_10(&similar));
     if !(given.is_finite() && at_speed.is_finite()) {
         return None;
     }
