@@ -588,19 +588,20 @@ pub fn diagnose(
     // only where both sets were sailed with alike commands: on a zig-zag the straight speed
     // is an extrapolation to a rudder held amidships, which the records never show
     // (effect-free zig-zags against a PRBS reference read 3.7 m/s against 7.7 on Mariner)
-    if other.is_none() {
-        caveats.extend(caveat::other_speed(ch.speeds, ch.course_speeds, resolution));
-    }
+    let speed = other
+        .is_none()
+        .then(|| caveat::other_speed(ch.speeds, ch.course_speeds, resolution))
+        .flatten();
     // speed or current: the reference re-timed to the trials' speed, on the records whole
-    let ratio = caveats.iter().find_map(|c| match c {
-        Caveat::OtherSpeed {
+    let similar = match &speed {
+        Some(Caveat::OtherSpeed {
             trials_mps,
             reference_mps,
             ..
-        } => Some(trials_mps / reference_mps),
+        }) => similar::at_trials_speed(trials_mps / reference_mps, model, given[1], given[0]),
         _ => None,
-    });
-    caveats.extend(ratio.and_then(|s| similar::at_trials_speed(s, model, given[1], given[0])));
+    };
+    caveats.extend(speed.into_iter().chain(similar));
     caveats.extend(caveat::reference_environment(&ch, level));
     if let Some(x) = current_resolution.filter(|_| verdict_name != EffectKind::Current.name()) {
         caveats.push(Caveat::CurrentResolution { smallest_mps: x });

@@ -132,6 +132,17 @@ pub(super) fn reference_hull(
     own_search(base, reference, None, &cfg.augment).map(|f| f.model)
 }
 
+/// The settings `model`'s structure is identified again with on other records (the
+/// reference as it is, or re-timed): its order, at most 50 iterations, one thread.
+pub(super) fn refit_config(model: &Model) -> PemConfig {
+    PemConfig {
+        order: model.n,
+        max_iter: 50,
+        parallel: false,
+        ..PemConfig::default()
+    }
+}
+
 /// Is the model fitted to the trials rather than the reference? Then it has absorbed what
 /// the trials show — a slow gear or an angle limit above all — and the statistics against the
 /// reference lose their power. Said when the model is significantly worse on the reference
@@ -154,13 +165,7 @@ pub(super) fn foreign(
     min_pct: f64,
     alpha: f64,
 ) -> Option<f64> {
-    let pc = PemConfig {
-        order: model.n,
-        max_iter: 50,
-        parallel: false,
-        ..PemConfig::default()
-    };
-    pem::identify_from(reference, model, &pc)
+    pem::identify_from(reference, model, &refit_config(model))
         .ok()
         .and_then(|r| {
             let v = s1 / n1.max(1) as f64;

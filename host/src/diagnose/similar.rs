@@ -20,9 +20,10 @@
 
 use super::caveat::Caveat;
 use super::compare::mean_fit;
+use super::reference::refit_config;
 use super::rule::GAIN_PP;
 use crate::identify::model::Model;
-use crate::identify::pem::{self, PemConfig};
+use crate::identify::pem;
 use crate::identify::predict::Horizon;
 use crate::io::data::Record;
 
@@ -32,7 +33,8 @@ const RATIO_RANGE: (f64, f64) = (0.25, 4.0);
 
 /// `rec` as its hull would have sailed it at `s` times the speed, sampled at the record's
 /// own sample time: at time `t` the re-timed record holds the original's at `s·t` (the
-/// command held from the sample before, the rest interpolated linearly, angles unwrapped),
+/// command held from the sample before, the rest interpolated linearly, angles the short
+/// way round),
 /// its yaw rate, speed over ground and apparent wind speed times `s`. `None` when `s` is not
 /// finite and positive, or the record would keep fewer than two samples.
 pub(super) fn retime(rec: &Record, s: f64) -> Option<Record> {
@@ -104,13 +106,9 @@ pub(super) fn at_trials_speed(
         .iter()
         .map(|r| retime(r, ratio))
         .collect::<Option<_>>()?;
-    let pc = PemConfig {
-        order: model.n,
-        max_iter: 50,
-        parallel: false,
-        ..PemConfig::default()
-    };
-    let similar = pem::identify_from(&retimed, model, &pc).ok()?.model;
+    let similar = pem::identify_from(&retimed, model, &refit_config(model))
+        .ok()?
+        .model;
     let fit_10 = |m: &Model| mean_fit(m, est, &[Horizon::Steps(10)])[&Horizon::Steps(10).key()];
     let (given, at_speed) = (fit_10(model), fit_10(&similar));
     if !(given.is_finite() && at_speed.is_finite()) {
