@@ -480,13 +480,14 @@ fn other_speed(d: &Value) -> Option<&Value> {
 }
 
 #[test]
-fn against_a_simulator_at_its_design_speed_the_trials_other_speed_is_told_from_a_current() {
+fn against_a_simulator_at_its_design_speed_the_trials_are_diagnosed_at_their_own_speed() {
     // The same reference sailed at the hull's design speed (0.72 m/s at 3 m), more than
     // twice the records'. On zig-zags that each hold one course the ground track cannot
     // tell that from a current along the course (it resolves one only from about 2 m/s
     // on), so the caveat says both readings and names the speed to sail the reference at.
     // How the hull answers the helm tells them apart: the reference re-timed to the
-    // trials' speed by similarity predicts them far better, which a current would not.
+    // trials' speed by similarity predicts them far better, which a current would not, and
+    // the diagnosis is measured against it.
     let dir = scratch("design-speed");
     let path = |n: &str| dir.join(n).to_string_lossy().into_owned();
     simulator_reference(&dir, None);
@@ -528,9 +529,27 @@ fn against_a_simulator_at_its_design_speed_the_trials_other_speed_is_told_from_a
         words.contains("so the trials ran at another speed through the water"),
         "{words}"
     );
+    // so the statistics are measured against the reference at the trials' speed, where the
+    // verdict is the wind the pond measured, as against the simulator sailed at 0.3 m/s;
+    // against the reference as given it was an angle limit, the speed's own mimic
+    // (measured: `saturation, then wind`)
+    let at = d["caveats"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["caveat"] == "at-trials-speed")
+        .unwrap_or_else(|| panic!("not diagnosed at the trials' speed: {}", d["caveats"]));
+    assert_eq!(at["ratio"], s["ratio"], "{at}");
+    assert_eq!(at["verdict_as_given"], "saturation", "{at}");
+    assert_eq!(d["verdict"], "wind", "{}", d["explanation"]);
+    assert!(
+        words.contains("So every statistic is measured against the reference re-timed"),
+        "{words}"
+    );
     // the wind the anemometer shows does not depend on the reference's speed: the source's
     let wind = ranked(&d, "wind");
     assert_eq!(wind["significant"], true, "{wind}");
+    assert_eq!(wind["material"], true, "{wind}");
     let speed = wind["parameter"].as_f64().unwrap();
     assert!((speed - SOURCE_TRUE_WIND.0).abs() < 0.02, "{speed} m/s");
     let _ = std::fs::remove_dir_all(&dir);

@@ -192,6 +192,19 @@ pub enum Caveat {
         /// Whether it predicts them 1 pp or more better: the speed through the water differs.
         shows_speed: bool,
     },
+    /// The trials ran at another speed through the water ([`Caveat::SpeedSimilar`]'s
+    /// `shows_speed`), so every statistic was measured against the reference re-timed to
+    /// their speed and the model given's structure identified on it: against the reference
+    /// as given, the hull's own change with speed reads as an effect.
+    AtTrialsSpeed {
+        /// The trials' speed over the reference's.
+        ratio: f64,
+        /// The verdict against the reference as given.
+        verdict_as_given: String,
+        /// Its second effect, where it had one.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        then_as_given: Option<String>,
+    },
     /// The reference records show more of a current or wind than the trials — their own
     /// heading harmonics of the ground velocity, or the anemometer's true wind, the larger —
     /// and the change between the two is significant: a current or wind the reference
@@ -325,10 +338,7 @@ impl Caveat {
                     format!(
                         "{what}: the hull answers the helm as at the trials' speed, which a \
                          current would not change, so the trials ran at another speed through \
-                         the water. The statistics stay measured against the model given: \
-                         the re-timed records also scale the steering gear's rate and dead \
-                         time, which a real gear keeps, so they cannot stand in for a \
-                         reference sailed at the trials' speed."
+                         the water."
                     )
                 } else {
                     format!(
@@ -337,6 +347,26 @@ impl Caveat {
                          and not how the hull answers the helm."
                     )
                 }
+            }
+            Caveat::AtTrialsSpeed {
+                ratio,
+                verdict_as_given,
+                then_as_given,
+            } => {
+                let given = match then_as_given {
+                    Some(t) => format!("`{verdict_as_given}, then {t}`"),
+                    None => format!("`{verdict_as_given}`"),
+                };
+                format!(
+                    "So every statistic is measured against the reference re-timed to the \
+                     trials' speed (×{}) and the model given's structure identified on it: \
+                     against the reference as given, the hull's own change with speed reads as \
+                     an effect (the verdict there: {given}). Similarity holds to first order, \
+                     and the re-timed records scale the steering gear's slew rate and dead time \
+                     with the hull, which a real gear keeps: a reference sailed at the trials' \
+                     speed is the stronger test.",
+                    sig(*ratio)
+                )
             }
             Caveat::NoReference => "No reference records were given, so every statistic is \
                 judged against the model alone: hull nonlinearity the model never had shows up \

@@ -343,7 +343,8 @@ pub enum DiagnoseError {
 ///
 /// Where the trials ran at another speed than the reference ([`Caveat::OtherSpeed`]), the
 /// reference re-timed to the trials' speed by similarity tells the speed through the water
-/// from a current along the courses ([`Caveat::SpeedSimilar`]).
+/// from a current along the courses ([`Caveat::SpeedSimilar`]); where it is the speed, the
+/// diagnosis is measured against the re-timed reference ([`Caveat::AtTrialsSpeed`]).
 ///
 /// Long: the driver: the method's steps in the order the module docs give them, each a call to
 /// its own module.
@@ -354,10 +355,33 @@ pub fn diagnose(
     val: &[Record],
     cfg: &DiagnoseConfig,
 ) -> Result<Diagnosis, DiagnoseError> {
+    check(model, reference, est, val, cfg)?;
+    run(model, reference, est, val, cfg, Against::Given)
+}
+
+/// Which reference a run of the method measures the trials against.
+#[derive(Clone, Copy, PartialEq)]
+enum Against {
+    /// The reference as given; where the trials ran at another speed through the water,
+    /// the method runs again at theirs.
+    Given,
+    /// The reference re-timed to the trials' speed, the model given's structure identified
+    /// on it ([`similar::at_trials_speed`]).
+    TrialsSpeed,
+}
+
+/// The method against `reference` ([`diagnose`], its inputs checked).
+fn run(
+    model: &Model,
+    reference: &[Record],
+    est: &[Record],
+    val: &[Record],
+    cfg: &DiagnoseConfig,
+    against: Against,
+) -> Result<Diagnosis, DiagnoseError> {
     // Long: the steps in their order (the reference's own gear, the statistics on the
     // records, the bootstrap nulls, the ranking, materiality, the refit, the words), each a
     // call, with the intermediate results they share held here.
-    check(model, reference, est, val, cfg)?;
     let reps = cfg.null_reps.max(8);
     let given = [est, reference, val];
     // long sets are diagnosed on blocks spread over them (see `WINDOW`)
@@ -386,7 +410,7 @@ pub fn diagnose(
     } else {
         None
     };
-    let model = offset.as_ref().map_or(model, |o| &o.model);
+    let (given_model, model) = (model, offset.as_ref().map_or(model, |o| &o.model));
     // The reference's own actuator physics (module docs): the statistics are measured against
     // the reference model that carries it, `base`; `model` is what the user gave (a plain
     // model with the reference's own offset added, above).
@@ -396,6 +420,7 @@ pub fn diagnose(
     } else {
         None
     };
+    let at_trials_speed = against == Against::TrialsSpeed;
     bar.inc(1);
     bar.set_message("statistics on the records");
     let base = gear.as_ref().map_or(model, |g| &g.model);
@@ -588,17 +613,25 @@ pub fn diagnose(
     // only where both sets were sailed with alike commands: on a zig-zag the straight speed
     // is an extrapolation to a rudder held amidships, which the records never show
     // (effect-free zig-zags against a PRBS reference read 3.7 m/s against 7.7 on Mariner)
-    let speed = other
-        .is_none()
+    let speed = (other.is_none() && !at_trials_speed)
         .then(|| caveat::other_speed(ch.speeds, ch.course_speeds, resolution))
         .flatten();
     // speed or current: the reference re-timed to the trials' speed, on the records whole
-    let similar = match &speed {
+    let (similar, at_speed) = match &speed {
         Some(Caveat::OtherSpeed {
             trials_mps,
             reference_mps,
             ..
-        }) => similar::at_trials_speed(trials_mps / reference_mps, model, given[1], given[0]),
+        }) => similar::at_trials_speed(trials_mps / reference_mps, given_model, given[1], given[0])
+            .map_or((None, None), |(c, at)| (Some(c), Some(at))),
+        _ => (None, None),
+    };
+    let again = match &similar {
+        Some(Caveat::SpeedSimilar {
+            ratio,
+            shows_speed: true,
+            ..
+        }) => at_speed.map(|at| (*ratio, at)),
         _ => None,
     };
     caveats.extend(speed.into_iter().chain(similar));
@@ -689,6 +722,29 @@ pub fn diagnose(
     }
     if then.as_deref() == Some(EffectKind::Wind.name()) {
         caveats.retain(|c| !matches!(c, Caveat::WindResolution { .. }));
+    }
+    // the trials ran at another speed through the water: the method again, against the
+    // reference at theirs, the verdict against the reference as given said beside it
+    if let Some((ratio, at)) = again {
+        let against = Against::TrialsSpeed;
+        if let Ok(mut d) = run(&at.model, &at.reference, given[0], given[2], cfg, against) {
+            let more: Vec<Caveat> = caveats
+                .iter()
+                .filter(|c| matches!(c, Caveat::OtherSpeed { .. } | Caveat::SpeedSimilar { .. }))
+                .cloned()
+                .chain([Caveat::AtTrialsSpeed {
+                    ratio,
+                    verdict_as_given: verdict_name,
+                    then_as_given: then,
+                }])
+                .collect();
+            for c in &more {
+                d.explanation.push(' ');
+                d.explanation.push_str(&c.explain());
+            }
+            d.caveats.extend(more);
+            return Ok(d);
+        }
     }
     for c in &caveats {
         explanation.push(' ');
