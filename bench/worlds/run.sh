@@ -53,6 +53,8 @@
 #                     record) times K (`simulate --disturbance`; default 1; 2 a rougher day
 #                     than the reference's); not on the built-in ship, which has none
 #   --ref-disturbance K  the same for the reference records
+#   --ref-design-speed  the reference sailed at the world's design speed whatever :U says
+#                     (the trials at U: a reference at another speed than the trials)
 #   --ref-effect NAME the reference records sailed with a library effect at full strength
 #                     (`simulate --effect`; e.g. wind: a reference sailed on a windy day,
 #                     the trials in whatever the case hides)
@@ -89,6 +91,7 @@ duration=""
 trialdist=""
 refdist=""
 refeffect=""
+refdesign=""
 while [ $# -gt 0 ]; do
     case "$1" in
         --yawcast) yawcast="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
@@ -109,7 +112,8 @@ while [ $# -gt 0 ]; do
         --trial-disturbance) trialdist="--disturbance $2"; shift 2 ;;
         --ref-disturbance) refdist="--disturbance $2"; shift 2 ;;
         --ref-effect) refeffect="--effect $2"; shift 2 ;;
-        -h|--help) sed -n '2,63p' "$0"; exit 0 ;;
+        --ref-design-speed) refdesign=1; shift ;;
+        -h|--help) sed -n '2,68p' "$0"; exit 0 ;;
         *) echo "unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
@@ -234,7 +238,11 @@ IFS=, read -r -a effect_list <<<"$effects"
 start=$(date +%s)
 for w in "${world_list[@]}"; do
     mkdir -p "$work/$w"
-    mapfile -t sim < <(world_args "$w")
+    if [ -n "$refdesign" ]; then
+        mapfile -t sim < <(world_args "${w%%:*}")
+    else
+        mapfile -t sim < <(world_args "$w")
+    fi
     # a reference is reused only when it was sailed with the same options (a work directory
     # of another run, without the anemometer say, would otherwise serve a stale one)
     # shellcheck disable=SC2206 # $logwind, $ts, $duration: one or two words, or none
