@@ -470,13 +470,18 @@ fn ranked<'a>(d: &'a Value, effect: &str) -> &'a Value {
         .unwrap_or_else(|| panic!("no {effect} ranked: {}", d["ranking"]))
 }
 
-/// The `other-speed` caveat of a diagnosis, if it has one.
-fn other_speed(d: &Value) -> Option<&Value> {
+/// The caveat `name` of a diagnosis, if it has one.
+fn caveat<'a>(d: &'a Value, name: &str) -> Option<&'a Value> {
     d["caveats"]
         .as_array()
         .unwrap()
         .iter()
-        .find(|c| c["caveat"] == "other-speed")
+        .find(|c| c["caveat"] == name)
+}
+
+/// The `other-speed` caveat of a diagnosis, if it has one.
+fn other_speed(d: &Value) -> Option<&Value> {
+    caveat(d, "other-speed")
 }
 
 #[test]
@@ -515,12 +520,7 @@ fn against_a_simulator_at_its_design_speed_the_trials_are_diagnosed_at_their_own
     assert!(words.contains("`simulate --speed 0.2"), "{words}");
     // measured: the re-timed reference predicts the trials 10 steps ahead at 70.1 %
     // against 37.0 % for the model given
-    let s = d["caveats"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|c| c["caveat"] == "speed-similar")
-        .unwrap_or_else(|| panic!("not re-timed: {}", d["caveats"]));
+    let s = caveat(&d, "speed-similar").unwrap_or_else(|| panic!("not re-timed: {}", d["caveats"]));
     assert_eq!(s["shows_speed"], true, "{s}");
     assert!((s["ratio"].as_f64().unwrap() - t / r).abs() < 1e-12, "{s}");
     let [given, similar] = ["fit_10_given_pct", "fit_10_similar_pct"].map(|k| fit(s, k));
@@ -533,11 +533,7 @@ fn against_a_simulator_at_its_design_speed_the_trials_are_diagnosed_at_their_own
     // verdict is the wind the pond measured, as against the simulator sailed at 0.3 m/s;
     // against the reference as given it was an angle limit, the speed's own mimic
     // (measured: `saturation, then wind`)
-    let at = d["caveats"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|c| c["caveat"] == "at-trials-speed")
+    let at = caveat(&d, "at-trials-speed")
         .unwrap_or_else(|| panic!("not diagnosed at the trials' speed: {}", d["caveats"]));
     assert_eq!(at["ratio"], s["ratio"], "{at}");
     assert_eq!(at["verdict_as_given"], "saturation", "{at}");

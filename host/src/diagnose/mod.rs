@@ -276,13 +276,16 @@ pub struct Diagnosis {
     /// most significant other effect measured against the model with the verdict's effect
     /// added, or `None`.
     pub then: Option<String>,
-    /// Held-out fit % of the model, keyed by horizon ("1","5","10","20","sim").
+    /// Held-out fit % of the model, keyed by horizon ("1","5","10","20","sim"); where
+    /// [`Caveat::AtTrialsSpeed`] is given, of the model identified on the re-timed
+    /// reference.
     pub before: BTreeMap<String, f64>,
     /// Held-out fit % of the model with the verdict's effect (same as `before` when `none`).
     pub after: BTreeMap<String, f64>,
     /// The reference model with the steering-gear dynamics the reference records show of
     /// their own (θ re-identified on them), when they show some: what the statistics were
-    /// measured against, and the better start for augmenting.
+    /// measured against (but where [`Caveat::AtTrialsSpeed`] is given: the reference as
+    /// given, whose records augment reads), and the better start for augmenting.
     #[serde(skip)]
     pub reference_gear: Option<Model>,
     /// The verdict's effect as the diagnosis measured it (θ frozen, its gains fitted on the
@@ -743,6 +746,9 @@ fn run(
                 d.explanation.push_str(&c.explain());
             }
             d.caveats.extend(more);
+            // `augment --effect auto` searches the ship's own physics on the reference as
+            // given, from the gear found there
+            d.reference_gear = gear.map(|g| g.model);
             return Ok(d);
         }
     }
