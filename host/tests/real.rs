@@ -537,6 +537,7 @@ fn against_a_simulator_at_its_design_speed_the_trials_are_diagnosed_at_their_own
         .unwrap_or_else(|| panic!("not diagnosed at the trials' speed: {}", d["caveats"]));
     assert_eq!(at["ratio"], s["ratio"], "{at}");
     assert_eq!(at["verdict_as_given"], "saturation", "{at}");
+    assert_eq!(at["then_as_given"], "wind", "{at}");
     assert_eq!(d["verdict"], "wind", "{}", d["explanation"]);
     assert!(
         words.contains("So every statistic is measured against the reference re-timed"),
