@@ -571,6 +571,14 @@ impl Caveat {
     }
 }
 
+/// Appends the words of `caveats` to `explanation`, in their order, each after a space.
+pub(super) fn append_words(explanation: &mut String, caveats: &[Caveat]) {
+    for c in caveats {
+        explanation.push(' ');
+        explanation.push_str(&c.explain());
+    }
+}
+
 /// The caveats of a diagnosis, in the order the explanation gives them.
 pub(super) fn caveats(
     offset_words: Option<&str>,

@@ -744,10 +744,7 @@ fn run(
                     then_as_given: then,
                 }])
                 .collect();
-            for c in &more {
-                d.explanation.push(' ');
-                d.explanation.push_str(&c.explain());
-            }
+            caveat::append_words(&mut d.explanation, &more);
             d.caveats.extend(more);
             // `augment --effect auto` searches the ship's own physics on the reference as
             // given, from the gear found there
@@ -755,10 +752,7 @@ fn run(
             return Ok(d);
         }
     }
-    for c in &caveats {
-        explanation.push(' ');
-        explanation.push_str(&c.explain());
-    }
+    caveat::append_words(&mut explanation, &caveats);
     Ok(Diagnosis {
         verdict: verdict_name,
         ranking,
