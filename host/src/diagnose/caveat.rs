@@ -108,6 +108,11 @@ pub enum Caveat {
         /// The share of the heading harmonics' variance the trials keep beyond each record's
         /// own offset and turn (under 0.005).
         separation: f64,
+        /// Where the trial records' courses were compared (`diagnose::course`): the widest
+        /// angle between two of them (deg) and the p-value of a moment that changes across
+        /// them (not significant: else wind would be named).
+        #[serde(skip_serializing_if = "Option::is_none")]
+        across: Option<[f64; 2]>,
     },
     /// An angle limit or a dead band named (first or second) on trials whose commands hold
     /// one magnitude — a zig-zag's ±20°: a limit below it and a dead band take the same off
@@ -430,16 +435,30 @@ impl Caveat {
                  would.",
                 100.0 * separation
             ),
-            Caveat::BiasOrWind { separation } => format!(
-                "The steady moment is named on trials that each hold one course (the heading \
-                 harmonics keep {:.2} % of their variance beyond each record's own offset and \
-                 turn) and no anemometer is logged: over one course a wind from one side \
-                 turns the ship as a steady moment does, and only a change of course would \
-                 change its moment. The records cannot tell a steady moment from a wind; the \
-                 anemometer's columns, or trials on several courses (a zig-zag or a PRBS on \
-                 each of four headings), would.",
-                100.0 * separation
-            ),
+            Caveat::BiasOrWind { separation, across } => match across {
+                None => format!(
+                    "The steady moment is named on trials that each hold one course (the \
+                     heading harmonics keep {:.2} % of their variance beyond each record's own \
+                     offset and turn) and no anemometer is logged: over one course a wind from \
+                     one side turns the ship as a steady moment does, and only a change of \
+                     course would change its moment. The records cannot tell a steady moment \
+                     from a wind; the anemometer's columns, or trials on several courses (a \
+                     zig-zag or a PRBS on each of four headings), would.",
+                    100.0 * separation
+                ),
+                Some([span, p]) => format!(
+                    "The steady moment is named on trials that each hold one course (the \
+                     heading harmonics keep {:.2} % of their variance beyond each record's own \
+                     offset and turn) and no anemometer is logged: over one course a wind from \
+                     one side turns the ship as a steady moment does, and only a change of \
+                     course changes its moment. Across the trials' courses, at most {span:.0}° \
+                     apart, the moment does not change beyond the records' noise (p {}); a \
+                     wind whose moment is alike on those courses is not ruled out. The \
+                     anemometer's columns, or trials on courses further apart, would tell.",
+                    100.0 * separation,
+                    fmt_p(*p)
+                ),
+            },
             Caveat::ClipOrDeadBand {
                 magnitude_deg,
                 share,
@@ -721,10 +740,13 @@ pub(super) fn bias_or_wind(
     named: &[EffectKind],
     separation: Option<f64>,
     anemometer: bool,
+    across: Option<[f64; 2]>,
 ) -> Option<Caveat> {
     let s = separation.filter(|&s| s < super::separation::MIN_HEADING_SEPARATION)?;
-    (!anemometer && named.contains(&EffectKind::Bias))
-        .then_some(Caveat::BiasOrWind { separation: s })
+    (!anemometer && named.contains(&EffectKind::Bias)).then_some(Caveat::BiasOrWind {
+        separation: s,
+        across,
+    })
 }
 
 #[cfg(test)]
@@ -741,22 +763,38 @@ mod tests {
     fn a_steady_moment_on_one_course_without_an_anemometer_may_be_a_wind() {
         let bias = [EffectKind::RateLimit, EffectKind::Bias];
         // an autopilot's or a zig-zag's one course, no anemometer: the caveat
-        let c = bias_or_wind(&bias, Some(0.0007), false).unwrap();
-        assert_eq!(c, Caveat::BiasOrWind { separation: 0.0007 });
+        let c = bias_or_wind(&bias, Some(0.0007), false, None).unwrap();
+        assert_eq!(
+            c,
+            Caveat::BiasOrWind {
+                separation: 0.0007,
+                across: None
+            }
+        );
         assert!(
             c.explain().contains("keep 0.07 % of their variance"),
             "{}",
             c.explain()
         );
-        assert_eq!(serde_json::to_value(&c).unwrap()["caveat"], "bias-or-wind");
-        assert_eq!(serde_json::to_value(&c).unwrap()["separation"], 0.0007);
+        let json = serde_json::to_value(&c).unwrap();
+        assert_eq!(json["caveat"], "bias-or-wind");
+        assert_eq!(json["separation"], 0.0007);
+        assert!(json.get("across").is_none(), "{json}");
+        // the records' courses compared: how far apart, and that no change showed
+        let c = bias_or_wind(&bias, Some(0.0007), false, Some([46.0, 0.62])).unwrap();
+        assert!(
+            c.explain().contains("at most 46° apart") && c.explain().contains("(p = 6.2e-1)"),
+            "{}",
+            c.explain()
+        );
+        assert_eq!(serde_json::to_value(&c).unwrap()["across"][0], 46.0);
         // the anemometer logged: it measures the wind itself
-        assert!(bias_or_wind(&bias, Some(0.0007), true).is_none());
+        assert!(bias_or_wind(&bias, Some(0.0007), true, None).is_none());
         // several courses (at the level or above), or no heading to judge: none
-        assert!(bias_or_wind(&bias, Some(0.005), false).is_none());
-        assert!(bias_or_wind(&bias, None, false).is_none());
+        assert!(bias_or_wind(&bias, Some(0.005), false, None).is_none());
+        assert!(bias_or_wind(&bias, None, false, None).is_none());
         // no steady moment named
-        assert!(bias_or_wind(&[EffectKind::Asymmetry], Some(0.0007), false).is_none());
+        assert!(bias_or_wind(&[EffectKind::Asymmetry], Some(0.0007), false, None).is_none());
     }
 
     #[test]

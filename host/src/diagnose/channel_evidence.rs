@@ -49,7 +49,26 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
         }
         Channel::SpeedOverGround => {
             let mut p_speed = None;
-            if let Some(s) = sog {
+            // on records that each hold one course, read across their courses
+            // (`course.rs`), the speed lost in each turn varies with the heading as a wind's
+            // drag does: the ground track is not counted towards a wind there
+            let across = ch.course.is_some() && !ch.yaw_tells_heading();
+            let sog_counts = !(kind == EffectKind::Wind && across);
+            // and a current, which carries the ship, is read from the ground track alone
+            // there, as on one course without them: the moment read across the courses
+            // tells it from a wind (`verdict::current_or_wind`)
+            let yaw_counts = ev.yaw_counted && !(kind == EffectKind::Current && across);
+            if let (Some(s), false) = (sog, sog_counts) {
+                let (chi, df, _) = s.test(false);
+                ev.words.push_str(&format!(
+                    "; speed over ground varies with heading by ±{:.3} m/s (1st harmonic) and \
+                     ±{:.3} m/s (2nd) (χ² = {chi:.1}, {df:.0} df): not counted towards a wind on \
+                     records that each hold one course, where the speed lost in each turn \
+                     varies with the heading as a wind's drag does",
+                    s.amp1, s.amp2
+                ));
+            }
+            if let (Some(s), true) = (sog, sog_counts) {
                 let current = kind == EffectKind::Current;
                 let (chi, df, p_sog) = s.test(current);
                 // a change the reference shows more of than the trials is not the trials'
@@ -59,14 +78,21 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
                 let calibration = s.calibration_words(current);
                 // either channel may show it (Bonferroni over the two); only speed over
                 // ground where the yaw channel is not counted
-                ev.channels = if ev.yaw_counted { 2 } else { 1 };
-                ev.p = if ev.yaw_counted {
+                ev.channels = if yaw_counts { 2 } else { 1 };
+                ev.p = if yaw_counts {
                     (2.0 * p_yaw.min(p_sog)).min(1.0)
                 } else {
                     p_sog
                 };
                 if current {
                     ev.p_ground = Some(p_sog);
+                }
+                if ev.yaw_counted && !yaw_counts {
+                    ev.words.push_str(
+                        "; a current carries the ship, so on records that each hold one \
+                         course its p is the ground track's alone, and the moment read across \
+                         the courses only tells it from a wind",
+                    );
                 }
                 if !theirs {
                     ev.score = ev.score.max(chi - df);
@@ -127,12 +153,13 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
                 // the direct channel: three tests now, Bonferroni over them
                 let (speed, from) = a.speed_from();
                 let p_sog = p_speed.unwrap_or(p_yaw);
+                let counted = if sog_counts { 3 } else { 2 };
                 // a wind the reference's anemometer shows more of is not the trials'
                 let theirs = a.the_references();
                 let p_air = a.p_trials();
-                ev.channels = if ev.yaw_counted { 3 } else { 2 };
+                ev.channels = if ev.yaw_counted { counted } else { 2 };
                 ev.p = if ev.yaw_counted {
-                    (3.0 * p_yaw.min(p_air).min(p_sog)).min(1.0)
+                    (counted as f64 * p_yaw.min(p_air).min(p_sog)).min(1.0)
                 } else {
                     (2.0 * p_air.min(p_sog)).min(1.0)
                 };

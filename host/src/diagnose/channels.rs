@@ -8,6 +8,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::anemometer::{anemometer_evidence, AnemometerEvidence};
+use super::course::CourseEvidence;
 use super::separation::{heading_separation, MIN_HEADING_SEPARATION};
 use crate::io::data::Record;
 use crate::io::data::{gyro_offset, GyroOffset};
@@ -37,6 +38,10 @@ pub(super) struct Channels {
     pub(super) course_speeds: Option<[f64; 2]>,
     /// The trials' [`heading_separation`], when every trial logs its heading.
     pub(super) separation: Option<f64>,
+    /// On trials that each hold one course ([`Channels::yaw_tells_heading`] false): what
+    /// their error offsets and slopes show of a moment that changes with the course (set
+    /// by the caller, which has the model).
+    pub(super) course: Option<CourseEvidence>,
 }
 
 impl Channels {
@@ -85,6 +90,7 @@ impl Channels {
             speeds,
             course_speeds,
             separation,
+            course: None,
         }
     }
 

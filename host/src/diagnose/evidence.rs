@@ -12,7 +12,7 @@ use crate::identify::predict::{self, Stepper};
 use crate::io::data::Record;
 
 /// Every `SLOW_STRIDE`-th sample's 50-step error is used (they overlap heavily anyway).
-const SLOW_STRIDE: usize = 10;
+pub(super) const SLOW_STRIDE: usize = 10;
 
 pub(super) fn horizon_of(kind: EffectKind) -> usize {
     if def(kind).slow {
@@ -52,6 +52,18 @@ fn errors(model: &Model, rec: &Record, x0: &[f64], h: usize) -> Vec<f64> {
         s.step(&mut st, rec.u[start], rec.y[start], psi(start));
     }
     out
+}
+
+/// [`errors`] from the record's own x̂(0), with the sample each error predicts.
+pub(super) fn errors_at(model: &Model, rec: &Record, h: usize) -> (Vec<f64>, Vec<usize>) {
+    let x0 = predict::estimate_x0(model, rec);
+    let e = errors(model, rec, &x0, h);
+    let at = if h <= 1 {
+        (0..e.len()).collect()
+    } else {
+        (0..e.len()).map(|j| h + j * SLOW_STRIDE).collect()
+    };
+    (e, at)
 }
 
 /// Least-squares pieces of one candidate on a set of records: `e₀ᵀe₀`, `Sᵀe₀`, `SᵀS` with

@@ -103,6 +103,7 @@ mod channel_evidence;
 mod channels;
 mod commands;
 pub mod compare;
+mod course;
 mod evidence;
 mod null;
 mod reference;
@@ -463,7 +464,11 @@ fn run(
         .filter(|k| !(*k == EffectKind::Saturation && u_max <= 0.0))
         .collect();
 
-    let ch = Channels::measure(whole.0, whole.1, cfg.seed);
+    let mut ch = Channels::measure(whole.0, whole.1, cfg.seed);
+    if ch.heading_ok && !ch.yaw_tells_heading() {
+        // one course per record: a moment that changes with the course, read across them
+        ch.course = course::course_evidence(base, est, reference, SLOW_HORIZON);
+    }
 
     let grids: Vec<(EffectKind, Vec<Effect>)> =
         kinds.iter().map(|&k| (k, grid(k, &span))).collect();
@@ -700,6 +705,7 @@ fn run(
         &named,
         ch.separation,
         ch.anemometer.is_some(),
+        ch.course.map(|c| [c.span_deg, c.p]),
     ));
     // a significant damping that predicts better beside an angle limit or a dead band named
     // on one magnitude: the third look-alike there
@@ -776,7 +782,8 @@ fn run(
 /// in the direction the errors show least, [`resolved_gains`]); for the gyro offset and
 /// the current, their channels' own. An effect whose p is the best of several channels
 /// (Bonferroni over them, `channel_evidence`) shows on one of them at `level` over their
-/// number; one whose yaw channel is not counted has no resolution there.
+/// number; one whose yaw channel is not counted, or is read across the courses of records
+/// that each hold one course, has no resolution there.
 fn resolutions(
     kinds: &[EffectKind],
     real: &[evidence::WorldStat],
@@ -798,7 +805,10 @@ fn resolutions(
                 EffectKind::Wind if ch.anemometer.is_some() => {
                     ch.anemometer.map(|a| a.smallest(at))
                 }
+                // on records that each hold one course the harmonics' null is not what
+                // decides (read across the courses, `course.rs`)
                 _ if !ev[i].yaw_counted => None,
+                k if k.needs_heading() && !ch.yaw_tells_heading() => None,
                 k if !crate::effects::def(k).gains.is_empty() => {
                     let d_crit = nulls[i].at(real[i].d).0.critical(at);
                     real[i].quad.smallest_gain(d_crit, &resolved_gains(k))

@@ -148,7 +148,37 @@ pub(super) fn effect_evidence(
              against {d:.0} here)"
         ));
     }
-    if kind.needs_heading() && !ch.yaw_tells_heading() {
+    if let (true, false, Some(c)) = (kind.needs_heading(), ch.yaw_tells_heading(), ch.course) {
+        // the records each hold one course: the yaw channel's harmonics are each record's
+        // own offset and turn, the same for the manoeuvre's mismatch on every course, so
+        // the moment is read across the courses (`course.rs`)
+        ev.p_yaw = c.p;
+        ev.p = c.p;
+        ev.score = c.chi - c.df;
+        ev.words.push_str(&format!(
+            "; the trials each hold one course (the heading harmonics keep {:.2} % of their \
+             variance beyond each record's own offset and turn), over which the harmonics \
+             cannot tell a moment varying with heading from the manoeuvre's own, which is \
+             the same on every course: read across the courses instead, the records' \
+             {h}-step error offsets ({:+.4} to {:+.4} °/s) and slopes on their own headings \
+             differ by χ² = {:.1} on {:.0} df{} (p {})",
+            100.0 * ch.separation.unwrap_or(0.0),
+            c.offsets[0],
+            c.offsets[1],
+            c.chi,
+            c.df,
+            if c.inflation > 1.0 {
+                format!(
+                    ", divided by {:.1}, what the reference records show against each other \
+                     on their own courses (an F test on {:.0} df)",
+                    c.inflation, c.inflation_df
+                )
+            } else {
+                String::new()
+            },
+            fmt_p(c.p)
+        ));
+    } else if kind.needs_heading() && !ch.yaw_tells_heading() {
         // the records each hold one course: the yaw channel's harmonics are each record's
         // own offset and turn (separation::heading_separation), and only the channels that
         // carry current and wind themselves can show them

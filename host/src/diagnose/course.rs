@@ -1,0 +1,233 @@
+//! Records that each hold one course: a yaw moment that changes with the course (a wind's,
+//! or a current's that turns the ship) shows as prediction errors whose offset and slope on
+//! the heading differ from record to record, while the manoeuvre's own mismatch with the
+//! linear model, the same on every course, moves them all alike.
+//!
+//! Over one course the heading harmonics of a record are its own offset plus a slope on
+//! how far it has turned (`separation.rs`), and so is what a linear model misses of the
+//! hull in every swing: on such records the yaw channel's harmonic regression cannot tell
+//! a wind from the manoeuvre. But the manoeuvre's part is the same on every course, and a
+//! wind's is not: from one side it pushes the ship one way, from the other the other way,
+//! and how fast it grows with the heading changes with the course too. So each record's
+//! `h`-step errors are regressed on an offset and the heading about its own mean, and the
+//! test is whether those pairs differ between the trial records by more than their noise
+//! (a Wald χ² against the weighted mean, `2(m − 1)` df for `m` records). The noise is
+//! estimated within each record (Newey–West: the errors of overlapping horizons are
+//! correlated) and calibrated on the reference records, which sail no wind of their own:
+//! their χ² per degree of freedom, where above 1, divides the trials' (an F test then, on
+//! the reference's degrees of freedom), as the ground velocity's lanes are calibrated.
+
+use nalgebra::{Matrix2, Vector2};
+
+use super::evidence::errors_at;
+use crate::identify::model::Model;
+use crate::io::data::Record;
+use crate::stats::{chi2_sf, f_sf};
+
+/// What the trials' error offsets and slopes on their own courses show of a yaw moment
+/// that changes with the course.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct CourseEvidence {
+    /// Wald χ² of the trial records' (offset, slope) pairs against their weighted mean,
+    /// divided by `inflation`.
+    pub(super) chi: f64,
+    /// Its degrees of freedom, `2(m − 1)`.
+    pub(super) df: f64,
+    /// The reference records' own χ² per degree of freedom (≥ 1).
+    pub(super) inflation: f64,
+    /// Its degrees of freedom (∞ where the inflation is 1).
+    pub(super) inflation_df: f64,
+    /// p-value: F on (`df`, `inflation_df`), or χ² where the inflation is 1.
+    pub(super) p: f64,
+    /// The smallest and largest of the trial records' error offsets (yaw-rate units, °/s).
+    pub(super) offsets: [f64; 2],
+    /// The widest angle between two trial records' mean headings (deg, 0–180): how far
+    /// apart the courses compared lie.
+    pub(super) span_deg: f64,
+}
+
+/// Each record's `h`-step errors and the headings (rad) of the samples they predict.
+fn record_errors(model: &Model, rec: &Record, h: usize) -> Option<(Vec<f64>, Vec<f64>)> {
+    let psi = rec.psi.as_ref()?;
+    let (e, at) = errors_at(model, rec, h);
+    let x = at.iter().map(|&t| psi[t].to_radians()).collect();
+    Some((e, x))
+}
+
+/// The (offset, slope) of errors `e` on headings `x` about their own mean (slope per
+/// radian), with their Newey–West covariance. `None` for too few samples.
+fn fit(e: &[f64], x: &[f64], h: usize) -> Option<(Vector2<f64>, Matrix2<f64>)> {
+    let n = e.len();
+    if n < 8 {
+        return None;
+    }
+    let mean = x.iter().sum::<f64>() / n as f64;
+    let x: Vec<f64> = x.iter().map(|v| v - mean).collect();
+    let sxx: f64 = x.iter().map(|v| v * v).sum();
+    if sxx.is_nan() || sxx <= 0.0 {
+        return None;
+    }
+    let a = e.iter().sum::<f64>() / n as f64;
+    let b = x.iter().zip(e).map(|(xi, ei)| xi * ei).sum::<f64>() / sxx;
+    let r: Vec<f64> = e.iter().zip(&x).map(|(ei, xi)| ei - a - b * xi).collect();
+    // Newey–West over the scores (r, r·x): overlapping horizons, a slow disturbance
+    let lags = (2 * h / errors_stride(h)).clamp(1, n / 4);
+    let mut s = Matrix2::zeros();
+    for l in 0..=lags {
+        let w = if l == 0 {
+            1.0
+        } else {
+            1.0 - l as f64 / (lags + 1) as f64
+        };
+        let mut g = Matrix2::zeros();
+        for t in l..n {
+            let u = Vector2::new(r[t], r[t] * x[t]);
+            let v = Vector2::new(r[t - l], r[t - l] * x[t - l]);
+            g += u * v.transpose();
+        }
+        s += if l == 0 { g } else { (g + g.transpose()) * w };
+    }
+    // (XᵀX)⁻¹ with X = [1, x] centred: diagonal
+    let inv = Matrix2::new(1.0 / n as f64, 0.0, 0.0, 1.0 / sxx);
+    let cov = inv * s * inv;
+    Some((Vector2::new(a, b), cov))
+}
+
+/// The samples between two `h`-step errors ([`errors_at`]).
+fn errors_stride(h: usize) -> usize {
+    if h <= 1 {
+        1
+    } else {
+        super::evidence::SLOW_STRIDE
+    }
+}
+
+/// Wald χ² of the pieces' (offset, slope) pairs ([`fit`]) against their precision-weighted
+/// mean, and its degrees of freedom; the offsets' range. `None` for fewer than two pieces.
+fn between(pieces: &[(&[f64], &[f64])], h: usize) -> Option<(f64, f64, [f64; 2])> {
+    let fits: Vec<(Vector2<f64>, Matrix2<f64>)> = pieces
+        .iter()
+        .map(|(e, x)| fit(e, x, h))
+        .collect::<Option<_>>()?;
+    if fits.len() < 2 {
+        return None;
+    }
+    let infos: Vec<Matrix2<f64>> = fits
+        .iter()
+        .map(|(_, v)| v.try_inverse())
+        .collect::<Option<_>>()?;
+    let info: Matrix2<f64> = infos.iter().sum();
+    let num: Vector2<f64> = infos.iter().zip(&fits).map(|(i, (t, _))| i * t).sum();
+    let mean = info.try_inverse()? * num;
+    let chi: f64 = infos
+        .iter()
+        .zip(&fits)
+        .map(|(i, (t, _))| {
+            let d = t - mean;
+            d.dot(&(i * d))
+        })
+        .sum();
+    let offsets = fits.iter().map(|(t, _)| t[0]);
+    let lo = offsets.clone().fold(f64::INFINITY, f64::min);
+    let hi = offsets.fold(f64::NEG_INFINITY, f64::max);
+    Some((chi.max(0.0), 2.0 * (fits.len() - 1) as f64, [lo, hi]))
+}
+
+/// Each record of `set` whole, as (errors, headings).
+fn whole(set: &[(Vec<f64>, Vec<f64>)]) -> Vec<(&[f64], &[f64])> {
+    set.iter().map(|(e, x)| (&e[..], &x[..])).collect()
+}
+
+/// [`CourseEvidence`] of the trials `est` against `reference`, on `model`'s `h`-step errors.
+/// `None` with fewer than two trial records, a record without heading or too short, or a
+/// singular fit.
+pub(super) fn course_evidence(
+    model: &Model,
+    est: &[Record],
+    reference: &[Record],
+    h: usize,
+) -> Option<CourseEvidence> {
+    let errs = |recs: &[Record]| -> Option<Vec<(Vec<f64>, Vec<f64>)>> {
+        recs.iter().map(|r| record_errors(model, r, h)).collect()
+    };
+    let (trial, refs) = (errs(est)?, errs(reference)?);
+    let (raw, df, offsets) = between(&whole(&trial), h)?;
+    // the noise: the reference's records against each other, on their own courses
+    let (inflation, inflation_df) = match between(&whole(&refs), h) {
+        Some((c, d, _)) if c / d > 1.0 => (c / d, d),
+        _ => (1.0, f64::INFINITY),
+    };
+    let chi = raw / inflation;
+    let p = if inflation_df.is_finite() {
+        f_sf(chi / df, df, inflation_df)
+    } else {
+        chi2_sf(chi, df)
+    };
+    // each record's mean heading (the circular mean of the samples its errors predict)
+    let courses: Vec<f64> = trial
+        .iter()
+        .map(|(_, x)| {
+            let (s, c) = x
+                .iter()
+                .fold((0.0, 0.0), |(s, c), v| (s + v.sin(), c + v.cos()));
+            s.atan2(c).to_degrees()
+        })
+        .collect();
+    let mut span_deg: f64 = 0.0;
+    for (i, a) in courses.iter().enumerate() {
+        for b in &courses[i + 1..] {
+            span_deg = span_deg.max(((a - b + 180.0).rem_euclid(360.0) - 180.0).abs());
+        }
+    }
+    Some(CourseEvidence {
+        chi,
+        df,
+        inflation,
+        inflation_df,
+        p,
+        offsets,
+        span_deg,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Errors `offset + slope·x` plus a deterministic noise of std ≈ 0.01 on headings that
+    /// swing ±0.35 rad about the course.
+    fn piece(offset: f64, slope: f64, seed: u64) -> (Vec<f64>, Vec<f64>) {
+        let mut s = seed;
+        let mut noise = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((s >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.035
+        };
+        let x: Vec<f64> = (0..200).map(|t| 0.35 * (t as f64 / 15.0).sin()).collect();
+        let e = x.iter().map(|&xi| offset + slope * xi + noise()).collect();
+        (e, x)
+    }
+
+    #[test]
+    fn records_whose_offsets_differ_with_the_course_stand_out_and_alike_ones_do_not() {
+        // three records with the manoeuvre's own slope (0.2) and offset (0.05): alike
+        let alike: Vec<_> = (0..3).map(|i| piece(0.05, 0.2, i)).collect();
+        let (chi, df, offsets) = between(&whole(&alike), 1).unwrap();
+        assert_eq!(df, 4.0);
+        assert!(chi < 13.3, "{chi}"); // χ²₄ at 0.01
+        assert!(offsets[1] - offsets[0] < 0.01, "{offsets:?}");
+        // a wind's: each course its own offset and slope
+        let wind: Vec<_> = [(0.02, 0.1), (0.08, 0.3), (0.05, -0.1)]
+            .iter()
+            .enumerate()
+            .map(|(i, &(a, b))| piece(a, b, i as u64))
+            .collect();
+        let (chi, _, offsets) = between(&whole(&wind), 1).unwrap();
+        assert!(chi > 100.0, "{chi}");
+        assert!((offsets[0] - 0.02).abs() < 0.005, "{offsets:?}");
+        assert!((offsets[1] - 0.08).abs() < 0.005, "{offsets:?}");
+        // one record: nothing to compare
+        assert!(between(&whole(&wind[..1]), 1).is_none());
+    }
+}
