@@ -19,7 +19,7 @@
 
 use nalgebra::{Matrix2, Vector2};
 
-use super::evidence::errors_at;
+use super::evidence::{error_stride, errors_at};
 use crate::identify::model::Model;
 use crate::io::data::Record;
 use crate::stats::{chi2_sf, f_sf};
@@ -71,7 +71,7 @@ fn fit(e: &[f64], x: &[f64], h: usize) -> Option<(Vector2<f64>, Matrix2<f64>)> {
     let b = x.iter().zip(e).map(|(xi, ei)| xi * ei).sum::<f64>() / sxx;
     let r: Vec<f64> = e.iter().zip(&x).map(|(ei, xi)| ei - a - b * xi).collect();
     // Newey–West over the scores (r, r·x): overlapping horizons, a slow disturbance
-    let lags = (2 * h / errors_stride(h)).clamp(1, n / 4);
+    let lags = (2 * h / error_stride(h)).clamp(1, n / 4);
     let mut s = Matrix2::zeros();
     for l in 0..=lags {
         let w = if l == 0 {
@@ -91,15 +91,6 @@ fn fit(e: &[f64], x: &[f64], h: usize) -> Option<(Vector2<f64>, Matrix2<f64>)> {
     let inv = Matrix2::new(1.0 / n as f64, 0.0, 0.0, 1.0 / sxx);
     let cov = inv * s * inv;
     Some((Vector2::new(a, b), cov))
-}
-
-/// The samples between two `h`-step errors ([`errors_at`]).
-fn errors_stride(h: usize) -> usize {
-    if h <= 1 {
-        1
-    } else {
-        super::evidence::SLOW_STRIDE
-    }
 }
 
 /// Wald χ² of the pieces' (offset, slope) pairs ([`fit`]) against their precision-weighted

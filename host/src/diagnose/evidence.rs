@@ -12,7 +12,7 @@ use crate::identify::predict::{self, Stepper};
 use crate::io::data::Record;
 
 /// Every `SLOW_STRIDE`-th sample's 50-step error is used (they overlap heavily anyway).
-pub(super) const SLOW_STRIDE: usize = 10;
+const SLOW_STRIDE: usize = 10;
 
 pub(super) fn horizon_of(kind: EffectKind) -> usize {
     if def(kind).slow {
@@ -58,12 +58,18 @@ fn errors(model: &Model, rec: &Record, x0: &[f64], h: usize) -> Vec<f64> {
 pub(super) fn errors_at(model: &Model, rec: &Record, h: usize) -> (Vec<f64>, Vec<usize>) {
     let x0 = predict::estimate_x0(model, rec);
     let e = errors(model, rec, &x0, h);
-    let at = if h <= 1 {
-        (0..e.len()).collect()
-    } else {
-        (0..e.len()).map(|j| h + j * SLOW_STRIDE).collect()
-    };
+    let first = if h <= 1 { 0 } else { h };
+    let at = (0..e.len()).map(|j| first + j * error_stride(h)).collect();
     (e, at)
+}
+
+/// The samples between two of [`errors`]' `h`-step errors.
+pub(super) fn error_stride(h: usize) -> usize {
+    if h <= 1 {
+        1
+    } else {
+        SLOW_STRIDE
+    }
 }
 
 /// Least-squares pieces of one candidate on a set of records: `e₀ᵀe₀`, `Sᵀe₀`, `SᵀS` with
