@@ -70,9 +70,15 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
             }
             if let (Some(s), true) = (sog, sog_counts) {
                 let current = kind == EffectKind::Current;
-                let (chi, df, p_sog) = s.test(current);
+                // on records that each hold one course a current is read across their
+                // courses (`carry.rs`): the harmonics see it within each only from ~2 m/s
+                let carry = ch.across_carry().filter(|_| current);
+                let (chi, df, p_sog) = match carry {
+                    Some(c) => (c.chi, 2.0, c.p),
+                    None => s.test(current),
+                };
                 // a change the reference shows more of than the trials is not the trials'
-                let theirs = s.the_references();
+                let theirs = carry.is_none() && s.the_references();
                 let p_sog = if theirs { 1.0 } else { p_sog };
                 p_speed = Some(p_sog);
                 let calibration = s.calibration_words(current);
@@ -98,7 +104,33 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
                     ev.score = ev.score.max(chi - df);
                 }
                 ev.channel_material = p_sog < cfg.alpha / cfg_m(cfg);
-                if let (EffectKind::Current, Some(c)) = (kind, s.cross) {
+                if let Some(c) = carry {
+                    let (speed, dir) = c.speed_dir();
+                    ev.parameter = Some(speed);
+                    ev.words.push_str(&format!(
+                        "; read across the courses (each record's mean speed over ground \
+                         {}, projected on its own headings; courses {:.0}° apart), the ground \
+                         velocity shows a current of {speed:.3} m/s setting towards {dir:.0}° \
+                         beside {:.3} m/s through the water (χ² = {chi:.1}, 2 df{}, p {})",
+                        if c.lanes == 2 {
+                            "along and across the heading"
+                        } else {
+                            "along the heading"
+                        },
+                        c.span_deg,
+                        c.through,
+                        if c.inflation > 1.0 {
+                            format!(
+                                ", divided by {:.1}, what the reference records show against \
+                                 each other (an F test on {:.0} df)",
+                                c.inflation, c.inflation_df
+                            )
+                        } else {
+                            String::new()
+                        },
+                        super::verdict::fmt_p(c.p)
+                    ));
+                } else if let (EffectKind::Current, Some(c)) = (kind, s.cross) {
                     let (speed, dir) = c.speed_dir();
                     ev.parameter = Some(speed);
                     ev.words.push_str(&format!(

@@ -8,6 +8,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::anemometer::{anemometer_evidence, AnemometerEvidence};
+use super::carry::CarryEvidence;
 use super::course::CourseEvidence;
 use super::separation::{heading_separation, MIN_HEADING_SEPARATION};
 use crate::io::data::Record;
@@ -42,6 +43,8 @@ pub(super) struct Channels {
     /// their error offsets and slopes show of a moment that changes with the course (set
     /// by the caller, which has the model).
     pub(super) course: Option<CourseEvidence>,
+    /// On such trials: what their ground velocities show of a current across their courses.
+    pub(super) carry: Option<CarryEvidence>,
 }
 
 impl Channels {
@@ -91,6 +94,7 @@ impl Channels {
             course_speeds,
             separation,
             course: None,
+            carry: None,
         }
     }
 
@@ -98,6 +102,11 @@ impl Channels {
     /// [`heading_separation`] at least [`MIN_HEADING_SEPARATION`] (or no heading logged).
     pub(super) fn yaw_tells_heading(&self) -> bool {
         !matches!(self.separation, Some(s) if s < MIN_HEADING_SEPARATION)
+    }
+
+    /// [`Channels::carry`] where it reads a current: trials that each hold one course.
+    pub(super) fn across_carry(&self) -> Option<CarryEvidence> {
+        self.carry.filter(|_| !self.yaw_tells_heading())
     }
 }
 
@@ -117,7 +126,7 @@ pub(super) enum Lane {
 
 /// Time constants (s) of the sway nuisance of the cross-track lane: a hull's sway time
 /// constant is about `L/U` (≈ 5 s on a model ship, ≈ 40 s on a full-scale tanker).
-const CROSS_TAUS_S: [f64; 4] = [3.0, 10.0, 30.0, 90.0];
+pub(super) const CROSS_TAUS_S: [f64; 4] = [3.0, 10.0, 30.0, 90.0];
 /// Speed over ground (m/s) below which a course is not used.
 const CROSS_MIN_SPEED: f64 = 0.1;
 

@@ -98,6 +98,7 @@
 
 mod anemometer;
 pub mod augment;
+mod carry;
 mod caveat;
 mod channel_evidence;
 mod channels;
@@ -468,6 +469,11 @@ fn run(
     if ch.heading_ok && !ch.yaw_tells_heading() {
         // one course per record: a moment that changes with the course, read across them
         ch.course = course::course_evidence(base, est, reference, SLOW_HORIZON);
+        // and a current, which carries every record alike, from their ground velocities
+        ch.carry = ch
+            .speed_ok
+            .then(|| carry::carry_evidence(whole.0, whole.1))
+            .flatten();
     }
 
     let grids: Vec<(EffectKind, Vec<Effect>)> =
@@ -617,7 +623,13 @@ fn run(
     );
     // speed through the water: told apart from a current only as far as the ground track
     // resolves one
-    let resolution = current_resolution.unwrap_or(f64::INFINITY);
+    // (the heading harmonics' resolution: over the ground on their courses, the speed
+    // figures of `other_speed` keep a current read across the courses in them)
+    let resolution = match ch.across_carry() {
+        Some(_) => ch.sog.as_ref().map(|s| s.smallest_current(level)),
+        None => current_resolution,
+    }
+    .unwrap_or(f64::INFINITY);
     // only where both sets were sailed with alike commands: on a zig-zag the straight speed
     // is an extrapolation to a rudder held amidships, which the records never show
     // (effect-free zig-zags against a PRBS reference read 3.7 m/s against 7.7 on Mariner)
@@ -800,7 +812,10 @@ fn resolutions(
             let at = level / f64::from(ev[i].channels);
             match k {
                 EffectKind::GyroBias => ch.hb.map(|g| g.smallest(level)),
-                EffectKind::Current => ch.sog.as_ref().map(|s| s.smallest_current(at)),
+                EffectKind::Current => match ch.across_carry() {
+                    Some(c) => Some(c.smallest(at)),
+                    None => ch.sog.as_ref().map(|s| s.smallest_current(at)),
+                },
                 // with an anemometer, the true wind it shows, as the wind's parameter is
                 EffectKind::Wind if ch.anemometer.is_some() => {
                     ch.anemometer.map(|a| a.smallest(at))
