@@ -22,6 +22,7 @@
 use nalgebra::{DMatrix, DVector, Matrix2, Vector2};
 
 use super::channels::{sog_taus, CROSS_TAUS_S};
+use super::course::widest_span;
 use super::separation::{heading_separation, MIN_HEADING_SEPARATION};
 use crate::io::data::Record;
 use crate::stats::{chi2_sf, f_quantile, f_sf};
@@ -59,6 +60,19 @@ impl CarryEvidence {
     pub(super) fn speed_dir(&self) -> (f64, f64) {
         let [n, e] = self.current;
         (n.hypot(e), e.atan2(n).to_degrees().rem_euclid(360.0))
+    }
+
+    /// The standard error of the current's speed (m/s): its spread along the direction it
+    /// sets (the larger of the two where it is nil).
+    pub(super) fn speed_se(&self) -> f64 {
+        let [[a, b], [_, d]] = self.cov;
+        let (speed, _) = self.speed_dir();
+        if speed > 0.0 {
+            let [n, e] = self.current.map(|x| x / speed);
+            (n * n * a + 2.0 * n * e * b + e * e * d).max(0.0).sqrt()
+        } else {
+            a.max(d).sqrt()
+        }
     }
 
     /// The smallest current (m/s) the test shows at `level`, in the direction the records
@@ -299,12 +313,7 @@ pub(super) fn carry_evidence(est: &[Record], reference: &[Record]) -> Option<Car
         .iter()
         .map(|(m, _)| m.cs[1].atan2(m.cs[0]).to_degrees())
         .collect();
-    let mut span_deg: f64 = 0.0;
-    for (i, a) in courses.iter().enumerate() {
-        for b in &courses[i + 1..] {
-            span_deg = span_deg.max(((a - b + 180.0).rem_euclid(360.0) - 180.0).abs());
-        }
-    }
+    let span_deg = widest_span(&courses);
     let c = cv * inflation;
     Some(CarryEvidence {
         chi,
@@ -381,6 +390,11 @@ mod tests {
         assert!(e.p < 1e-6, "{e:?}");
         assert!((speed - 0.3).abs() < 0.01, "{e:?}");
         assert!((dir - 90.0).abs() < 3.0, "{e:?}");
+        assert!(
+            e.speed_se() > 0.0 && e.speed_se() < 0.01,
+            "{}",
+            e.speed_se()
+        );
         assert!(e.smallest(0.01) < 0.1, "{}", e.smallest(0.01));
         // one course for all: the current cannot be told from the speed through the water
         let one: Vec<Record> = (0..3).map(|i| record(120.0, [0.0, 0.3], i)).collect();

@@ -107,6 +107,7 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
                 if let Some(c) = carry {
                     let (speed, dir) = c.speed_dir();
                     ev.parameter = Some(speed);
+                    ev.parameter_se = Some(c.speed_se());
                     ev.words.push_str(&format!(
                         "; read across the courses (each record's mean speed over ground \
                          {}, projected on its own headings; courses {:.0}° apart), the ground \

@@ -164,12 +164,7 @@ pub(super) fn course_evidence(
             s.atan2(c).to_degrees()
         })
         .collect();
-    let mut span_deg: f64 = 0.0;
-    for (i, a) in courses.iter().enumerate() {
-        for b in &courses[i + 1..] {
-            span_deg = span_deg.max(((a - b + 180.0).rem_euclid(360.0) - 180.0).abs());
-        }
-    }
+    let span_deg = widest_span(&courses);
     Some(CourseEvidence {
         chi,
         df,
@@ -179,6 +174,17 @@ pub(super) fn course_evidence(
         offsets,
         span_deg,
     })
+}
+
+/// The widest angle (deg, 0–180) between two of `courses` (deg).
+pub(super) fn widest_span(courses: &[f64]) -> f64 {
+    let mut span: f64 = 0.0;
+    for (i, a) in courses.iter().enumerate() {
+        for b in &courses[i + 1..] {
+            span = span.max(((a - b + 180.0).rem_euclid(360.0) - 180.0).abs());
+        }
+    }
+    span
 }
 
 #[cfg(test)]
