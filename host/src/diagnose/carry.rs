@@ -17,7 +17,12 @@
 //! freedom, where above 1, divides the trials' (an F test then), as the yaw channel's offsets
 //! are calibrated (`course.rs`). So the reference must hold one course per record as well:
 //! the records of a slow hull differ by more than what is left within each (KVLCC2's
-//! effect-free zig-zags by 62 times), and only records sailed alike show by how much.
+//! effect-free zig-zags by 62 times), and only records sailed alike show by how much. The
+//! trials' own means calibrate it too, where there are more of them than unknowns: their
+//! misfit of the one current per degree of freedom, where larger. An effect that changes the
+//! manoeuvre changes how far its records scatter, which the effect-free reference does not
+//! show (the Seiun Maru's angle limit named a 0.012 m/s current second without it), and a
+//! wind's set is no uniform current (Mariner's winds read `current` without it).
 
 use nalgebra::{DMatrix, DVector, Matrix2, Vector2};
 
@@ -37,10 +42,13 @@ const MIN_SPEED: f64 = 0.1;
 pub(super) struct CarryEvidence {
     /// Wald χ² of the current (2 df), divided by `inflation`.
     pub(super) chi: f64,
-    /// The reference records' own χ² per degree of freedom (≥ 1).
+    /// The reference records' own χ² per degree of freedom, or the trials' misfit of the one
+    /// current per degree of freedom, the larger (≥ 1).
     pub(super) inflation: f64,
     /// Its degrees of freedom (∞ where the inflation is 1).
     pub(super) inflation_df: f64,
+    /// Whether the inflation is the trials' own misfit (else the reference's).
+    pub(super) own_misfit: bool,
     /// p-value: F on (2, `inflation_df`), or χ² where the inflation is 1.
     pub(super) p: f64,
     /// The current's estimate (north, east), m/s.
@@ -285,7 +293,7 @@ pub(super) fn carry_evidence(est: &[Record], reference: &[Record]) -> Option<Car
         1
     };
     let trial = means(est, lanes)?;
-    let (theta, cov, _) = gls(&trial, true)?;
+    let (theta, cov, sse_t) = gls(&trial, true)?;
     let v = Vector2::new(theta[lanes], theta[lanes + 1]);
     let cv = Matrix2::new(
         cov[(lanes, lanes)],
@@ -298,11 +306,17 @@ pub(super) fn carry_evidence(est: &[Record], reference: &[Record]) -> Option<Car
     let refs = means(reference, lanes)?;
     let df = (lanes * (refs.len() - 1)) as f64;
     let (_, _, sse) = gls(&refs, false)?;
-    let (inflation, inflation_df) = if sse / df > 1.0 {
+    let (mut inflation, mut inflation_df) = if sse / df > 1.0 {
         (sse / df, df)
     } else {
         (1.0, f64::INFINITY)
     };
+    // and the trials' own misfit of the one current, where more means than unknowns
+    let df_t = (lanes * trial.len()) as f64 - (lanes + 2) as f64;
+    let own_misfit = df_t >= 1.0 && sse_t / df_t > inflation;
+    if own_misfit {
+        (inflation, inflation_df) = (sse_t / df_t, df_t);
+    }
     let chi = raw / inflation;
     let p = if inflation_df.is_finite() {
         f_sf(chi / 2.0, 2.0, inflation_df)
@@ -319,6 +333,7 @@ pub(super) fn carry_evidence(est: &[Record], reference: &[Record]) -> Option<Car
         chi,
         inflation,
         inflation_df,
+        own_misfit,
         p,
         current: [v[0], v[1]],
         cov: [[c[(0, 0)], c[(0, 1)]], [c[(1, 0)], c[(1, 1)]]],

@@ -122,9 +122,14 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
                         c.through,
                         if c.inflation > 1.0 {
                             format!(
-                                ", divided by {:.1}, what the reference records show against \
-                                 each other (an F test on {:.0} df)",
-                                c.inflation, c.inflation_df
+                                ", divided by {:.1}, what {} (an F test on {:.0} df)",
+                                c.inflation,
+                                if c.own_misfit {
+                                    "the trials' means leave beyond one current"
+                                } else {
+                                    "the reference records show against each other"
+                                },
+                                c.inflation_df
                             )
                         } else {
                             String::new()
