@@ -26,7 +26,7 @@
 
 use nalgebra::{DMatrix, DVector, Matrix2, Vector2};
 
-use super::channels::{sog_taus, CROSS_TAUS_S};
+use super::channels::{sog_taus, speed_towards, CROSS_TAUS_S};
 use super::course::widest_span;
 use super::separation::{heading_separation, MIN_HEADING_SEPARATION};
 use crate::io::data::Record;
@@ -66,8 +66,7 @@ pub(super) struct CarryEvidence {
 impl CarryEvidence {
     /// The current's speed (m/s) and the direction it sets towards (deg from north, 0–360).
     pub(super) fn speed_dir(&self) -> (f64, f64) {
-        let [n, e] = self.current;
-        (n.hypot(e), e.atan2(n).to_degrees().rem_euclid(360.0))
+        speed_towards(self.current)
     }
 
     /// The standard error of the current's speed (m/s): its spread along the direction it

@@ -71,7 +71,7 @@ pub(super) fn add_channels(ev: &mut Evidence, has_ref: bool, cfg: &DiagnoseConfi
             if let (Some(s), true) = (sog, sog_counts) {
                 let current = kind == EffectKind::Current;
                 // on records that each hold one course a current is read across their
-                // courses (`carry.rs`): the harmonics see it within each only from ~2 m/s
+                // courses (`carry.rs`): the harmonics see it within each from 2–30 m/s on
                 let carry = ch.across_carry().filter(|_| current);
                 let (chi, df, p_sog) = match carry {
                     Some(c) => (c.chi, 2.0, c.p),

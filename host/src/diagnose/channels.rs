@@ -473,9 +473,14 @@ pub(super) struct CrossEvidence {
 impl CrossEvidence {
     /// Speed (m/s) and the direction it sets towards (deg).
     pub(super) fn speed_dir(&self) -> (f64, f64) {
-        let [n, e] = self.current;
-        (n.hypot(e), e.atan2(n).to_degrees().rem_euclid(360.0))
+        speed_towards(self.current)
     }
+}
+
+/// The speed (m/s) of a current `(north, east)` and the direction it sets towards (deg from
+/// north, 0–360).
+pub(super) fn speed_towards([n, e]: [f64; 2]) -> (f64, f64) {
+    (n.hypot(e), e.atan2(n).to_degrees().rem_euclid(360.0))
 }
 
 impl SogEvidence {
