@@ -30,7 +30,7 @@ use super::channels::{sog_taus, speed_towards, CROSS_TAUS_S};
 use super::course::widest_span;
 use super::separation::{heading_separation, MIN_HEADING_SEPARATION};
 use crate::io::data::Record;
-use crate::stats::{chi2_sf, f_quantile, f_sf};
+use crate::stats::{f_quantile, f_sf};
 
 /// Batches each record's mean is judged on.
 const BATCHES: usize = 10;
@@ -49,7 +49,7 @@ pub(super) struct CarryEvidence {
     pub(super) inflation_df: f64,
     /// Whether the inflation is the trials' own misfit (else the reference's).
     pub(super) own_misfit: bool,
-    /// p-value: F on (2, `inflation_df`), or χ² where the inflation is 1.
+    /// p-value: F on (2, `inflation_df`), which is χ² where the inflation is 1.
     pub(super) p: f64,
     /// The current's estimate (north, east), m/s.
     pub(super) current: [f64; 2],
@@ -85,11 +85,8 @@ impl CarryEvidence {
     /// The smallest current (m/s) the test shows at `level`, in the direction the records
     /// show least.
     pub(super) fn smallest(&self, level: f64) -> f64 {
-        let crit = if self.inflation_df.is_finite() {
-            2.0 * f_quantile(level, 2.0, self.inflation_df)
-        } else {
-            -2.0 * level.ln()
-        };
+        // F on (2, ∞) is χ²(2)/2, so this holds for an inflation of 1 too
+        let crit = 2.0 * f_quantile(level, 2.0, self.inflation_df);
         let [[a, b], [_, d]] = self.cov;
         let worst = 0.5 * (a + d) + (0.25 * (a - d) * (a - d) + b * b).sqrt();
         (crit * worst).sqrt()
@@ -294,12 +291,7 @@ pub(super) fn carry_evidence(est: &[Record], reference: &[Record]) -> Option<Car
     let trial = means(est, lanes)?;
     let (theta, cov, sse_t) = gls(&trial, true)?;
     let v = Vector2::new(theta[lanes], theta[lanes + 1]);
-    let cv = Matrix2::new(
-        cov[(lanes, lanes)],
-        cov[(lanes, lanes + 1)],
-        cov[(lanes + 1, lanes)],
-        cov[(lanes + 1, lanes + 1)],
-    );
+    let cv: Matrix2<f64> = cov.fixed_view::<2, 2>(lanes, lanes).into_owned();
     let raw = v.dot(&(cv.try_inverse()? * v));
     // the noise: the reference's records against each other, on their own courses
     let refs = means(reference, lanes)?;
@@ -317,11 +309,7 @@ pub(super) fn carry_evidence(est: &[Record], reference: &[Record]) -> Option<Car
         (inflation, inflation_df) = (sse_t / df_t, df_t);
     }
     let chi = raw / inflation;
-    let p = if inflation_df.is_finite() {
-        f_sf(chi / 2.0, 2.0, inflation_df)
-    } else {
-        chi2_sf(chi, 2.0)
-    };
+    let p = f_sf(chi / 2.0, 2.0, inflation_df);
     let courses: Vec<f64> = trial
         .iter()
         .map(|(m, _)| m.cs[1].atan2(m.cs[0]).to_degrees())

@@ -22,7 +22,7 @@ use nalgebra::{Matrix2, Vector2};
 use super::evidence::{error_stride, errors_at};
 use crate::identify::model::Model;
 use crate::io::data::Record;
-use crate::stats::{chi2_sf, f_sf};
+use crate::stats::f_sf;
 
 /// What the trials' error offsets and slopes on their own courses show of a yaw moment
 /// that changes with the course.
@@ -37,7 +37,7 @@ pub(super) struct CourseEvidence {
     pub(super) inflation: f64,
     /// Its degrees of freedom (∞ where the inflation is 1).
     pub(super) inflation_df: f64,
-    /// p-value: F on (`df`, `inflation_df`), or χ² where the inflation is 1.
+    /// p-value: F on (`df`, `inflation_df`), which is χ² where the inflation is 1.
     pub(super) p: f64,
     /// The smallest and largest of the trial records' error offsets (yaw-rate units, °/s).
     pub(super) offsets: [f64; 2],
@@ -149,11 +149,8 @@ pub(super) fn course_evidence(
         _ => (1.0, f64::INFINITY),
     };
     let chi = raw / inflation;
-    let p = if inflation_df.is_finite() {
-        f_sf(chi / df, df, inflation_df)
-    } else {
-        chi2_sf(chi, df)
-    };
+    // F on (df, ∞) is χ²(df)/df: one form for an inflation of 1 too
+    let p = f_sf(chi / df, df, inflation_df);
     // each record's mean heading (the circular mean of the samples its errors predict)
     let courses: Vec<f64> = trial
         .iter()
