@@ -61,6 +61,8 @@ pub(super) struct CarryEvidence {
     pub(super) lanes: usize,
     /// The widest angle between two trial records' mean headings (deg, 0–180).
     pub(super) span_deg: f64,
+    /// The trial records' mean (cos ψ, sin ψ), each record's own mean weighted alike.
+    pub(super) courses_cs: [f64; 2],
 }
 
 impl CarryEvidence {
@@ -80,6 +82,13 @@ impl CarryEvidence {
         } else {
             a.max(d).sqrt()
         }
+    }
+
+    /// The current's mean component (m/s) along the trials' courses, each record weighted
+    /// alike: what it adds to their mean speed over ground along the heading.
+    pub(super) fn along_courses(&self) -> f64 {
+        let [n, e] = self.current;
+        n * self.courses_cs[0] + e * self.courses_cs[1]
     }
 
     /// The smallest current (m/s) the test shows at `level`, in the direction the records
@@ -315,6 +324,10 @@ pub(super) fn carry_evidence(est: &[Record], reference: &[Record]) -> Option<Car
         .map(|(m, _)| m.cs[1].atan2(m.cs[0]).to_degrees())
         .collect();
     let span_deg = widest_span(&courses);
+    let k = trial.len() as f64;
+    let courses_cs = trial.iter().fold([0.0; 2], |[a, b], (m, _)| {
+        [a + m.cs[0] / k, b + m.cs[1] / k]
+    });
     let c = cv * inflation;
     Some(CarryEvidence {
         chi,
@@ -327,6 +340,7 @@ pub(super) fn carry_evidence(est: &[Record], reference: &[Record]) -> Option<Car
         through: theta[0],
         lanes,
         span_deg,
+        courses_cs,
     })
 }
 
@@ -338,6 +352,11 @@ mod tests {
     /// through the water with a leeway of 0.02 m/s to starboard, carried by `current`
     /// (north, east, m/s), with a deterministic noise of ±0.02 m/s.
     fn record(course: f64, current: [f64; 2], seed: u64) -> Record {
+        record_at(1.0, course, current, seed)
+    }
+
+    /// [`record`] at `speed` (m/s) through the water.
+    fn record_at(speed: f64, course: f64, current: [f64; 2], seed: u64) -> Record {
         let mut s = seed;
         let mut noise = || {
             s = s
@@ -350,9 +369,9 @@ mod tests {
         for t in 0..n {
             let h = course + 20.0 * (t as f64 / 40.0).sin();
             let (sh, ch) = h.to_radians().sin_cos();
-            // through the water: 1.0 along the heading, 0.02 across it to starboard
-            let north = 1.0 * ch - 0.02 * sh + current[0] + noise();
-            let east = 1.0 * sh + 0.02 * ch + current[1] + noise();
+            // through the water: `speed` along the heading, 0.02 across it to starboard
+            let north = speed * ch - 0.02 * sh + current[0] + noise();
+            let east = speed * sh + 0.02 * ch + current[1] + noise();
             psi.push(h);
             sog.push(north.hypot(east));
             cog.push(east.atan2(north).to_degrees());
@@ -417,5 +436,77 @@ mod tests {
         }
         assert!(carry_evidence(&carried, &circling).is_none());
         assert!(carry_evidence(&carried, &[]).is_none());
+    }
+
+    /// The mean over `recs` of each record's mean speed over ground along its heading.
+    fn along(recs: &[Record]) -> f64 {
+        let one = |r: &Record| {
+            let (psi, sog, cog) = (r.psi.as_ref(), r.speed.as_ref(), r.cog.as_ref());
+            let (psi, sog, cog) = (psi.unwrap(), sog.unwrap(), cog.unwrap());
+            let n = psi.len() as f64;
+            (0..psi.len())
+                .map(|t| sog[t] * (cog[t] - psi[t]).to_radians().cos())
+                .sum::<f64>()
+                / n
+        };
+        recs.iter().map(one).sum::<f64>() / recs.len() as f64
+    }
+
+    #[test]
+    fn another_speed_is_told_from_a_current_along_the_courses_read_across_them() {
+        use crate::diagnose::caveat::{other_speed, through_water, Caveat};
+        let reference: Vec<Record> = (0..3)
+            .map(|i| record(40.0 * i as f64, [0.0; 2], i))
+            .collect();
+        let courses = [60.0, 85.0, 110.0];
+        let trials = |speed: f64, current: [f64; 2]| -> Vec<Record> {
+            courses
+                .iter()
+                .enumerate()
+                .map(|(i, &c)| record_at(speed, c, current, 10 + i as u64))
+                .collect()
+        };
+        let read = |t: &[Record]| {
+            let c = carry_evidence(t, &reference).unwrap();
+            let course = [along(t), along(&reference)];
+            // the heading harmonics of one-course records resolve no current
+            let (speeds, resolution) = through_water(Some(&c), Some(course), None, None, 0.01);
+            (c, course, speeds.unwrap(), resolution)
+        };
+        // at the reference's speed, carried 0.3 m/s east along the courses: 27 % faster
+        // over the ground on them, and the same speed through the water
+        let (c, course, speeds, resolution) = read(&trials(1.0, [0.0, 0.3]));
+        assert!((course[0] / course[1] - 1.27).abs() < 0.01, "{course:?}");
+        // (about 0.27 m/s: the current's mean component along headings 40–130°)
+        let a = c.along_courses();
+        assert!(
+            a > 0.25 && (a - (course[0] - 1.0)).abs() < 0.01,
+            "{a} {course:?}"
+        );
+        assert!((speeds[0] - 1.0).abs() < 0.01, "{speeds:?}");
+        assert!(resolution < 0.1, "{resolution}");
+        assert_eq!(other_speed(Some(speeds), Some(course), resolution), None);
+        // the harmonics alone could not tell, and said both readings
+        assert!(matches!(
+            other_speed(None, Some(course), f64::INFINITY),
+            Some(Caveat::OtherSpeed {
+                told_from_current: false,
+                ..
+            })
+        ));
+        // 20 % slower through the water in calm: told from a current
+        let (c, course, speeds, resolution) = read(&trials(0.8, [0.0; 2]));
+        assert!(c.along_courses().abs() < 0.01, "{c:?}");
+        match other_speed(Some(speeds), Some(course), resolution) {
+            Some(Caveat::OtherSpeed {
+                trials_mps,
+                reference_mps,
+                told_from_current: true,
+            }) => {
+                assert!((trials_mps - 0.8).abs() < 0.01, "{trials_mps}");
+                assert!((reference_mps - 1.0).abs() < 0.01, "{reference_mps}");
+            }
+            other => panic!("{other:?}"),
+        }
     }
 }

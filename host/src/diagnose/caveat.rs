@@ -3,6 +3,7 @@
 use serde::Serialize;
 use yawcast_shared::model::EffectKind;
 
+use super::carry::CarryEvidence;
 use super::channels::Channels;
 use super::rule::{GAIN_PP, NO_GAIN_PP};
 use super::verdict::{effect_phrase, fmt_p, Evidence, Moment};
@@ -164,15 +165,17 @@ pub enum Caveat {
     /// the reference's: a hull's rudder gain and time constants change with speed through
     /// the water, which the library's effects can only mimic. Either the difference exceeds
     /// the smallest current the ground track can show ([`Caveat::CurrentResolution`]), so it
-    /// is the speed through the water; or it does not — records that each hold one course
-    /// cannot tell a current along it from the speed — and the caveat says both. Given only
+    /// is the speed through the water; or it does not — records that each hold one course,
+    /// and courses too alike to read a current across, cannot tell a current along them
+    /// from the speed — and the caveat says both. Given only
     /// for trials sailed with commands like the reference's (no
     /// [`Caveat::OtherManoeuvre`]): a zig-zag's straight speed is an extrapolation.
     OtherSpeed {
         /// The trials' speed straight ahead (m/s): through the water where
-        /// `told_from_current` (speed over ground less the current its heading harmonics
-        /// show and the speed lost in turns), else over the ground on their courses (less
-        /// the speed lost in turns only).
+        /// `told_from_current` (speed over ground less the current the ground track shows —
+        /// its heading harmonics, or on records that each hold one course the current read
+        /// across their courses — and the speed lost in turns), else over the ground on
+        /// their courses (less the speed lost in turns only).
         trials_mps: f64,
         /// The reference's (m/s), read the same way.
         reference_mps: f64,
@@ -307,7 +310,7 @@ impl Caveat {
                     format!(
                         "The trials ran straight at {t} m/s through the water and the \
                          reference at {r} m/s ({pct:+.0} %; speed over ground less the \
-                         current its heading harmonics show and the speed lost in turns): \
+                         current the ground track shows and the speed lost in turns): \
                          {speed}. {remedy}."
                     )
                 } else {
@@ -645,6 +648,30 @@ pub(super) fn caveats(
 /// two differ by at most 5.7 %; the built-in ship's trials sailed with the propeller turning
 /// 8.0 instead of 10.5 rev/s, by 24 %.
 pub const OTHER_SPEED: f64 = 0.15;
+
+/// The speeds straight ahead `[trials, reference]` that [`other_speed`] compares as through
+/// the water, and the smallest current (m/s) the ground track shows, which tells their
+/// difference from a current. On records that each hold one course with a current read
+/// across their courses (`carry`, [`super::channels::Channels::across_carry`]): each set's
+/// speed on its courses (`course`) less that current's component along the trials' courses
+/// (the reference's own current is [`Caveat::ReferenceEnvironment`]'s), and the current's
+/// resolution at `level`. Else the heading harmonics' straight speeds (`speeds`) and their
+/// `resolution` (none given: no current can be told).
+pub(super) fn through_water(
+    carry: Option<&CarryEvidence>,
+    course: Option<[f64; 2]>,
+    speeds: Option<[f64; 2]>,
+    resolution: Option<f64>,
+    level: f64,
+) -> (Option<[f64; 2]>, f64) {
+    match carry {
+        Some(c) => (
+            course.map(|[t, r]| [t - c.along_courses(), r]),
+            c.smallest(level),
+        ),
+        None => (speeds, resolution.unwrap_or(f64::INFINITY)),
+    }
+}
 
 /// [`Caveat::OtherSpeed`] for the speeds `[trials, reference]` when they differ by
 /// [`OTHER_SPEED`] or more: through the water (`speeds`, [`super::channels::straight_speed`])

@@ -622,19 +622,20 @@ fn run(
         &ch,
     );
     // speed through the water: told apart from a current only as far as the ground track
-    // resolves one
-    // (the heading harmonics' resolution: over the ground on their courses, the speed
-    // figures of `other_speed` keep a current read across the courses in them)
-    let resolution = match ch.across_carry() {
-        Some(_) => ch.sog.as_ref().map(|s| s.smallest_current(level)),
-        None => current_resolution,
-    }
-    .unwrap_or(f64::INFINITY);
+    // resolves one; on records that each hold one course, the speed on their courses less
+    // the current read across them, which resolves it there
+    let (speeds, resolution) = caveat::through_water(
+        ch.across_carry().as_ref(),
+        ch.course_speeds,
+        ch.speeds,
+        current_resolution,
+        level,
+    );
     // only where both sets were sailed with alike commands: on a zig-zag the straight speed
     // is an extrapolation to a rudder held amidships, which the records never show
     // (effect-free zig-zags against a PRBS reference read 3.7 m/s against 7.7 on Mariner)
     let speed = (other.is_none() && !at_trials_speed)
-        .then(|| caveat::other_speed(ch.speeds, ch.course_speeds, resolution))
+        .then(|| caveat::other_speed(speeds, ch.course_speeds, resolution))
         .flatten();
     // speed or current: the reference re-timed to the trials' speed, on the records whole
     let (similar, at_speed) = match &speed {
