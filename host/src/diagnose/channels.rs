@@ -40,7 +40,7 @@ pub(super) struct Channels {
     /// The trials' [`heading_separation`], when every trial logs its heading.
     pub(super) separation: Option<f64>,
     /// On trials that each hold one course ([`Channels::yaw_tells_heading`] false): what
-    /// their error offsets and slopes show of a moment that changes with the course (set
+    /// their error offsets show of a moment that changes with the course (set
     /// by the caller, which has the model).
     pub(super) course: Option<CourseEvidence>,
     /// On such trials: what their ground velocities show of a current across their courses.

@@ -160,8 +160,9 @@ pub(super) fn effect_evidence(
              variance beyond each record's own offset and turn), over which the harmonics \
              cannot tell a moment varying with heading from the manoeuvre's own, which is \
              the same on every course: read across the courses instead, the records' \
-             {h}-step error offsets ({:+.4} to {:+.4} °/s) and slopes on their own headings \
-             differ by χ² = {:.1} on {:.0} df{} (p {})",
+             {h}-step error offsets on their own courses ({:+.4} to {:+.4} °/s; each about \
+             the record's mean heading, its slope on the heading taken out) differ by \
+             χ² = {:.1} on {:.0} df{} (p {})",
             100.0 * ch.separation.unwrap_or(0.0),
             c.offsets[0],
             c.offsets[1],
