@@ -383,11 +383,16 @@ mod tests {
         r
     }
 
+    /// Three calm [`record`]s on courses 0°, 40° and 80°.
+    fn calm_reference() -> Vec<Record> {
+        (0..3)
+            .map(|i| record(40.0 * i as f64, [0.0; 2], i))
+            .collect()
+    }
+
     #[test]
     fn a_current_is_read_across_the_courses_and_alike_courses_show_none() {
-        let reference: Vec<Record> = (0..3)
-            .map(|i| record(40.0 * i as f64, [0.0; 2], i))
-            .collect();
+        let reference = calm_reference();
         let courses = [120.0, 95.0, 145.0];
         // no current: the means agree once each is projected on its own heading
         let calm: Vec<Record> = courses
@@ -455,9 +460,7 @@ mod tests {
     #[test]
     fn another_speed_is_told_from_a_current_along_the_courses_read_across_them() {
         use crate::diagnose::caveat::{other_speed, through_water, Caveat};
-        let reference: Vec<Record> = (0..3)
-            .map(|i| record(40.0 * i as f64, [0.0; 2], i))
-            .collect();
+        let reference = calm_reference();
         let courses = [60.0, 85.0, 110.0];
         let trials = |speed: f64, current: [f64; 2]| -> Vec<Record> {
             courses

@@ -166,8 +166,8 @@ pub enum Caveat {
     /// the water, which the library's effects can only mimic. Either the difference exceeds
     /// the smallest current the ground track can show ([`Caveat::CurrentResolution`]), so it
     /// is the speed through the water; or it does not — records that each hold one course,
-    /// and courses too alike to read a current across, cannot tell a current along them
-    /// from the speed — and the caveat says both. Given only
+    /// on courses too alike to read a current across them, cannot tell a current along
+    /// them from the speed — and the caveat says both. Given only
     /// for trials sailed with commands like the reference's (no
     /// [`Caveat::OtherManoeuvre`]): a zig-zag's straight speed is an extrapolation.
     OtherSpeed {

@@ -18,15 +18,13 @@
 //! their χ² per degree of freedom, where above 1, divides the trials' (an F test then, on
 //! the reference's degrees of freedom), as the ground velocity's lanes are calibrated.
 
-use nalgebra::{Matrix2, Vector2};
-
 use super::evidence::{error_stride, errors_at};
 use crate::identify::model::Model;
 use crate::io::data::Record;
 use crate::stats::f_sf;
 
-/// What the trials' error offsets and slopes on their own courses show of a yaw moment
-/// that changes with the course.
+/// What the trials' error offsets on their own courses show of a yaw moment that changes
+/// with the course.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct CourseEvidence {
     /// χ² of the trial records' error offsets against their weighted mean, divided by
@@ -55,9 +53,10 @@ fn record_errors(model: &Model, rec: &Record, h: usize) -> Option<(Vec<f64>, Vec
     Some((e, x))
 }
 
-/// The (offset, slope) of errors `e` on headings `x` about their own mean (slope per
-/// radian), with their Newey–West covariance. `None` for too few samples.
-fn fit(e: &[f64], x: &[f64], h: usize) -> Option<(Vector2<f64>, Matrix2<f64>)> {
+/// The offset of errors `e` on headings `x` (their mean, about the headings' own mean),
+/// with its Newey–West variance over what is left beyond the offset and a slope on the
+/// heading. `None` for too few samples.
+fn fit(e: &[f64], x: &[f64], h: usize) -> Option<(f64, f64)> {
     let n = e.len();
     if n < 8 {
         return None;
@@ -71,27 +70,20 @@ fn fit(e: &[f64], x: &[f64], h: usize) -> Option<(Vector2<f64>, Matrix2<f64>)> {
     let a = e.iter().sum::<f64>() / n as f64;
     let b = x.iter().zip(e).map(|(xi, ei)| xi * ei).sum::<f64>() / sxx;
     let r: Vec<f64> = e.iter().zip(&x).map(|(ei, xi)| ei - a - b * xi).collect();
-    // Newey–West over the scores (r, r·x): overlapping horizons, a slow disturbance
+    // Newey–West over the residuals: overlapping horizons, a slow disturbance
     let lags = (2 * h / error_stride(h)).clamp(1, n / 4);
-    let mut s = Matrix2::zeros();
+    let mut s = 0.0;
     for l in 0..=lags {
         let w = if l == 0 {
             1.0
         } else {
             1.0 - l as f64 / (lags + 1) as f64
         };
-        let mut g = Matrix2::zeros();
-        for t in l..n {
-            let u = Vector2::new(r[t], r[t] * x[t]);
-            let v = Vector2::new(r[t - l], r[t - l] * x[t - l]);
-            g += u * v.transpose();
-        }
-        s += if l == 0 { g } else { (g + g.transpose()) * w };
+        let g: f64 = (l..n).map(|t| r[t] * r[t - l]).sum();
+        s += if l == 0 { g } else { (g + g) * w };
     }
-    // (XᵀX)⁻¹ with X = [1, x] centred: diagonal
-    let inv = Matrix2::new(1.0 / n as f64, 0.0, 0.0, 1.0 / sxx);
-    let cov = inv * s * inv;
-    Some((Vector2::new(a, b), cov))
+    let inv = 1.0 / n as f64;
+    Some((a, inv * s * inv))
 }
 
 /// χ² of the pieces' offsets ([`fit`]: each the mean error about the record's own mean
@@ -106,25 +98,25 @@ fn fit(e: &[f64], x: &[f64], h: usize) -> Option<(Vector2<f64>, Matrix2<f64>)> {
 /// spread and lost the offsets' difference: Mariner's hidden winds on zig-zags, offsets
 /// χ² = 25–70 on 2 df, read p = 0.011–0.065 that way.
 fn between(pieces: &[(&[f64], &[f64])], h: usize) -> Option<(f64, f64, [f64; 2])> {
-    let fits: Vec<(Vector2<f64>, Matrix2<f64>)> = pieces
+    let fits: Vec<(f64, f64)> = pieces
         .iter()
         .map(|(e, x)| fit(e, x, h))
         .collect::<Option<_>>()?;
     if fits.len() < 2 {
         return None;
     }
-    let w: Vec<f64> = fits.iter().map(|(_, v)| 1.0 / v[(0, 0)]).collect();
+    let w: Vec<f64> = fits.iter().map(|(_, v)| 1.0 / v).collect();
     let total: f64 = w.iter().sum();
     if !total.is_finite() || total <= 0.0 {
         return None;
     }
-    let mean = fits.iter().zip(&w).map(|((t, _), w)| w * t[0]).sum::<f64>() / total;
+    let mean = fits.iter().zip(&w).map(|((a, _), w)| w * a).sum::<f64>() / total;
     let chi: f64 = fits
         .iter()
         .zip(&w)
-        .map(|((t, _), w)| w * (t[0] - mean) * (t[0] - mean))
+        .map(|((a, _), w)| w * (a - mean) * (a - mean))
         .sum();
-    let offsets = fits.iter().map(|(t, _)| t[0]);
+    let offsets = fits.iter().map(|(a, _)| *a);
     let lo = offsets.clone().fold(f64::INFINITY, f64::min);
     let hi = offsets.fold(f64::NEG_INFINITY, f64::max);
     Some((chi.max(0.0), (fits.len() - 1) as f64, [lo, hi]))
