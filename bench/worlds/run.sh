@@ -7,6 +7,7 @@
 #                       [--augment] [--won-back] [--trial-input KIND] [--ref-input KIND]
 #                       [--ts S] [--noise-scale K] [--duration S]
 #                       [--trial-disturbance K] [--ref-disturbance K] [--ref-effect NAME]
+#                       [--ref-log-angle] [--trial-log-angle]
 #
 #   --yawcast PATH    the binary (default: build the ci profile and use it)
 #   --work DIR        records, models and diagnoses (default target/bench-worlds)
@@ -58,6 +59,10 @@
 #   --ref-effect NAME the reference records sailed with a library effect at full strength
 #                     (`simulate --effect`; e.g. wind: a reference sailed on a windy day,
 #                     the trials in whatever the case hides)
+#   --ref-log-angle   the reference records log the steering gear's angle in delta_deg
+#                     instead of the command (`simulate --log-angle`: a rig that logs the
+#                     rudder's own angle), the trials the command: the gear lies between
+#   --trial-log-angle the trials (and the validation record) log the gear's angle
 #
 # Per world: the reference is 3 records of the world's identification input (seeds 900–902,
 # gyro noise 0.02 °/s, heading noise 0.1°) and the model identified on them; each case is 3
@@ -92,6 +97,8 @@ trialdist=""
 refdist=""
 refeffect=""
 refdesign=""
+refangle=""
+trialangle=""
 while [ $# -gt 0 ]; do
     case "$1" in
         --yawcast) yawcast="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
@@ -113,7 +120,9 @@ while [ $# -gt 0 ]; do
         --ref-disturbance) refdist="--disturbance $2"; shift 2 ;;
         --ref-effect) refeffect="--effect $2"; shift 2 ;;
         --ref-design-speed) refdesign=1; shift ;;
-        -h|--help) sed -n '2,68p' "$0"; exit 0 ;;
+        --ref-log-angle) refangle="--log-angle"; shift ;;
+        --trial-log-angle) trialangle="--log-angle"; shift ;;
+        -h|--help) sed -n '2,73p' "$0"; exit 0 ;;
         *) echo "unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
@@ -126,8 +135,8 @@ export YAWCAST="$yawcast" WORK="$work" LOGWIND="$logwind" AUGMENT="$augment" WON
 export TRIALINPUT="$trialinput" TSARG="$ts $duration"
 # the sensors' noise: the trials' (and the validation record's), the reference's
 scaled() { awk -v a="$1" -v k="$noisescale" 'BEGIN { print a * k }'; }
-export TRIALNOISE="--gyro-noise $(scaled 0.03) --heading-noise $(scaled 0.2) --speed-noise $(scaled 0.02) $trialdist"
-refnoise=(--gyro-noise "$(scaled 0.02)" --heading-noise "$(scaled 0.1)" $refdist $refeffect)
+export TRIALNOISE="--gyro-noise $(scaled 0.03) --heading-noise $(scaled 0.2) --speed-noise $(scaled 0.02) $trialdist $trialangle"
+refnoise=(--gyro-noise "$(scaled 0.02)" --heading-noise "$(scaled 0.1)" $refdist $refeffect $refangle)
 
 # a world's `simulate` arguments, one a line: NAME, NAME@L for the world scaled to L m,
 # either with :U for the approach speed U m/s

@@ -82,6 +82,10 @@ pub struct SimulateArgs {
     /// day, 0 none). Only on the new worlds: the built-in ship has none.
     #[arg(long, value_name = "K", default_value_t = 1.0)]
     pub disturbance: f64,
+    /// Log the steering gear's angle in `delta_deg` instead of the command: as a rig that
+    /// logs the rudder's own angle (its feedback), the gear between the command and it.
+    #[arg(long)]
+    pub log_angle: bool,
     /// Log the apparent wind (anemometer) columns.
     #[arg(long)]
     pub log_wind: bool,
@@ -305,6 +309,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         },
         effects: effects.clone(),
         log_wind: args.log_wind,
+        log_angle: args.log_angle,
         initial_heading_deg: args.heading,
         disturbance: args.disturbance,
         ..Scenario::default()

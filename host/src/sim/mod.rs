@@ -176,6 +176,9 @@ pub struct Scenario {
     pub effects: Vec<SimEffect>,
     /// Log the apparent wind (anemometer) channels.
     pub log_wind: bool,
+    /// Log the steering gear's angle at each sample in the command column instead of the
+    /// command: a rig that logs the rudder's (pod's) own angle, its gear between.
+    pub log_angle: bool,
     /// Heading at `t = 0` (deg); `None` draws it uniformly from `[0, 360)` with the seed.
     pub initial_heading_deg: Option<f64>,
     /// Straight run at δ = 0 before `t = 0`, so the record starts settled (s); default 120.
@@ -199,6 +202,7 @@ impl Default for Scenario {
             noise: NoiseSpec::default(),
             effects: Vec::new(),
             log_wind: false,
+            log_angle: false,
             initial_heading_deg: None,
             warmup_s: 120.0,
             dt_max: 0.1,
@@ -283,6 +287,8 @@ pub(crate) struct Sample<'a> {
     pub k: usize,
     pub state: &'a [f64; NX],
     pub model: &'a Model,
+    /// The gear's angle (rad).
+    pub delta: f64,
 }
 
 /// Integrates the ship over `spec.n` samples. At each sample `observe` sees the state (and
@@ -330,6 +336,7 @@ pub(crate) fn run(
             k,
             state: &s,
             model: &model,
+            delta: act.delta,
         });
         if !go || k + 1 == spec.n {
             break;
@@ -457,6 +464,7 @@ fn simulate_full(
         (None, None) => 0.0,
     };
     let mut states: Vec<([f64; NX], dynamics::Apparent)> = Vec::with_capacity(n);
+    let mut angles = Vec::with_capacity(n);
     run(
         &spec,
         |k, s| {
@@ -471,6 +479,7 @@ fn simulate_full(
                 dynamics::Apparent::default()
             };
             states.push((*smp.state, app));
+            angles.push(smp.delta.to_degrees());
             true
         },
     )?;
@@ -491,7 +500,11 @@ fn simulate_full(
         nav.east_m.push(s[4]);
     }
     for (k, (s, app)) in states.iter().enumerate() {
-        rec.u.push(cmds[k]);
+        rec.u.push(if scenario.log_angle {
+            angles[k]
+        } else {
+            cmds[k]
+        });
         let g = if ns.gyro_std_degps > 0.0 {
             ns.gyro_std_degps * inputs::gauss(&mut nr)
         } else {

@@ -160,3 +160,34 @@ fn bisection_finds_a_root_from_either_side_and_keeps_the_last_bracket() {
     // One halving leaves the midpoint of the half that holds the root.
     assert_eq!(bisect(0.0, 8.0, 1, |x| x > 1.0).to_bits(), 2f64.to_bits());
 }
+
+#[test]
+fn the_gears_angle_is_logged_in_place_of_the_command_and_nothing_else_changes() {
+    let ship = Ship::default_lng();
+    let cmd = simulate(&ship, &Scenario::default(), 7).unwrap();
+    let angle_scenario = Scenario {
+        log_angle: true,
+        ..Scenario::default()
+    };
+    let angle = simulate(&ship, &angle_scenario, 7).unwrap();
+    // the same run: the ship's channels bit for bit, only the command column differs
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&cmd.y), bits(&angle.y));
+    assert_eq!(
+        bits(cmd.psi.as_ref().unwrap()),
+        bits(angle.psi.as_ref().unwrap())
+    );
+    let step = |u: &[f64]| {
+        u.windows(2)
+            .map(|w| (w[1] - w[0]).abs())
+            .fold(0.0, f64::max)
+    };
+    // PRBS commands step by up to 40°; the pod slews at most max_rate over a sample
+    assert_eq!(step(&cmd.u), 40.0);
+    let slew = ship.actuator.max_rate_degps * angle.ts;
+    assert!(step(&angle.u) <= slew + 1e-9, "{} > {slew}", step(&angle.u));
+    assert!(step(&angle.u) > 0.5 * slew, "{}", step(&angle.u));
+    // and it follows the command: within the gear's lag of it
+    let lag = max_abs_diff(&cmd.u, &angle.u);
+    assert!(lag > 1.0 && lag <= 40.0, "{lag}");
+}

@@ -750,7 +750,11 @@ fn simulate_hull(
         }
     };
     for (k, (s, w)) in states.iter().enumerate() {
-        rec.u.push(cmds[k]);
+        rec.u.push(if scenario.log_angle {
+            gears[k].delta.to_degrees()
+        } else {
+            cmds[k]
+        });
         let g = white(ns.gyro_std_degps);
         let gyro = s[2].to_degrees() + phys.gyro_bias + drift[k] + g;
         rec.y.push(quantise(gyro, sensors.gyro_lsb_degps));
