@@ -251,3 +251,116 @@ fn the_worlds_own_predictor_is_scored_beside_the_same_record() {
     assert!(!out.exists());
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// Three records of KVLCC2 (PRBS, 1 800 s) from seed `seed` in `dir`, named `{name}-{1,2,3}.csv`
+/// (their paths returned), with `extra` options.
+fn kvlcc2_set(dir: &std::path::Path, name: &str, seed: &str, extra: &[&str]) -> Vec<String> {
+    let out = dir.join(format!("{name}.csv"));
+    let path = out.to_str().unwrap().to_string();
+    let mut args = vec![
+        "simulate",
+        "--world",
+        "kvlcc2",
+        "--records",
+        "3",
+        "--seed",
+        seed,
+        "--out",
+        &path,
+    ];
+    args.extend_from_slice(extra);
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    (1..=3)
+        .map(|i| {
+            dir.join(format!("{name}-{i}.csv"))
+                .to_string_lossy()
+                .into_owned()
+        })
+        .collect()
+}
+
+/// The verdict and the `command-steps` caveat of `diagnose` on `trials` against `refs`.
+fn diagnose_on(
+    dir: &std::path::Path,
+    model: &str,
+    refs: &[String],
+    trials: &[String],
+) -> serde_json::Value {
+    let json = dir.join("diagnose.json").to_string_lossy().into_owned();
+    let mut args = vec!["diagnose", "--model", model, "--seed", "1", "--json", &json];
+    for r in refs {
+        args.extend_from_slice(&["--reference", r]);
+    }
+    for t in trials {
+        args.extend_from_slice(&["--data", t]);
+    }
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap()
+}
+
+#[test]
+fn a_reference_that_logs_the_gears_angle_names_the_gear_the_commands_pass() {
+    let d = scratch("log-angle");
+    // the reference logs the rudder's angle (the gear slews at 2.34 °/s), as a rig's
+    // feedback does; the cross-world suite's noise and seeds (`bench/worlds/run.sh
+    // --ref-log-angle`, seed 1)
+    let refs = kvlcc2_set(
+        &d,
+        "ref",
+        "900",
+        &[
+            "--log-angle",
+            "--gyro-noise",
+            "0.02",
+            "--heading-noise",
+            "0.1",
+        ],
+    );
+    let csv = std::fs::read_to_string(&refs[0]).unwrap();
+    let angle: Vec<f64> = (1..=1800).map(|k| row(&csv, k)[1]).collect();
+    let largest = angle
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .fold(0.0, f64::max);
+    assert!((largest - 2.34).abs() < 1e-6, "{largest}");
+    let model = d.join("ref").to_string_lossy().into_owned();
+    let o = run(&[
+        "identify", "--data", &refs[0], "--data", &refs[1], "--data", &refs[2], "--out", &model,
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let model = format!("{model}.postcard");
+    let noise = [
+        "--gyro-noise",
+        "0.03",
+        "--heading-noise",
+        "0.2",
+        "--speed-noise",
+        "0.02",
+    ];
+    // effect-free trials that log the command: the gear between is what they lack
+    let trials = kvlcc2_set(&d, "cmd", "100", &noise);
+    let v = diagnose_on(&d, &model, &refs, &trials);
+    assert_eq!(v["verdict"], "rate-limit", "{}", v["explanation"]);
+    let steps = v["caveats"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["caveat"] == "command-steps")
+        .unwrap_or_else(|| panic!("{}", v["caveats"]));
+    assert!(steps["trial_step_deg"].as_f64().unwrap() >= 20.0, "{steps}");
+    let slew = steps["slew_degps"].as_f64().unwrap();
+    assert!((slew - 2.34).abs() < 0.01, "{steps}");
+    // the same trials logging the angle too: nothing lacks, and no caveat
+    let mut both = noise.to_vec();
+    both.push("--log-angle");
+    let trials = kvlcc2_set(&d, "angle", "100", &both);
+    let v = diagnose_on(&d, &model, &refs, &trials);
+    assert_eq!(v["verdict"], "none", "{}", v["explanation"]);
+    assert!(
+        !v["caveats"].to_string().contains("command-steps"),
+        "{}",
+        v["caveats"]
+    );
+}

@@ -27,7 +27,7 @@
 use nalgebra::{DMatrix, DVector, Matrix2, Vector2};
 
 use super::channels::{sog_taus, speed_towards, CROSS_TAUS_S};
-use super::course::widest_span;
+use super::course::{set_apart, widest_span};
 use super::separation::{heading_separation, MIN_HEADING_SEPARATION};
 use crate::io::data::Record;
 use crate::stats::{f_quantile, f_sf};
@@ -281,7 +281,7 @@ fn gls(ms: &[(Mean, DMatrix<f64>)], current: bool) -> Option<(DVector<f64>, DMat
 /// [`CarryEvidence`] of the trials `est` against `reference`: both lanes where every record
 /// logs course over ground, else speed over ground alone. `None` with fewer than two trial
 /// records, a record without heading or speed or too short, courses too alike to tell a
-/// current, or a reference that cannot calibrate it: fewer than two records, or records
+/// current or not [`set_apart`], or a reference that cannot calibrate it: fewer than two records, or records
 /// that do not each hold one course ([`heading_separation`] at least
 /// [`MIN_HEADING_SEPARATION`]). A record's mean speed depends on its manoeuvre: PRBS
 /// records of KVLCC2, each with its own sequence, differ by 56 000 times the noise their
@@ -324,6 +324,9 @@ pub(super) fn carry_evidence(est: &[Record], reference: &[Record]) -> Option<Car
         .map(|(m, _)| m.cs[1].atan2(m.cs[0]).to_degrees())
         .collect();
     let span_deg = widest_span(&courses);
+    if !set_apart(span_deg, est) {
+        return None;
+    }
     let k = trial.len() as f64;
     let courses_cs = trial.iter().fold([0.0; 2], |[a, b], (m, _)| {
         [a + m.cs[0] / k, b + m.cs[1] / k]

@@ -161,6 +161,20 @@ pub enum Caveat {
         /// (each in words; empty when the reference shows none).
         hull: Vec<String>,
     },
+    /// One set's commands step where the other's inputs never move so fast: its largest
+    /// change over one sample is [`super::commands::STEP_RATIO`] times the other's or more
+    /// (one set logs the rudder's angle, the other the command). The set that never steps
+    /// cannot show how the ship answers a step, and a steering gear lies between the two:
+    /// where the trials step, a slew limit is judged against the reference's own spread.
+    CommandSteps {
+        /// The trials' largest change of δ over one sample (deg).
+        trial_step_deg: f64,
+        /// The reference's (deg).
+        reference_step_deg: f64,
+        /// The smaller of the two over the sample time (deg/s): the fastest the slower
+        /// set's inputs move.
+        slew_degps: f64,
+    },
     /// The trials ran at another speed than the reference, by [`OTHER_SPEED`] or more of
     /// the reference's: a hull's rudder gain and time constants change with speed through
     /// the water, which the library's effects can only mimic. Either the difference exceeds
@@ -531,6 +545,45 @@ impl Caveat {
                      steady moment; records sailed in the trials' conditions make a better \
                      reference.",
                     shown.join("; ")
+                )
+            }
+            Caveat::CommandSteps {
+                trial_step_deg,
+                reference_step_deg,
+                slew_degps,
+            } => {
+                let (fast, slow, logs, fast_step, slow_step) =
+                    if trial_step_deg > reference_step_deg {
+                        (
+                            "trials'",
+                            "reference's",
+                            "the reference logs the rudder/pod angle and the trials the command",
+                            trial_step_deg,
+                            reference_step_deg,
+                        )
+                    } else {
+                        (
+                            "reference's",
+                            "trials'",
+                            "the trials log the rudder/pod angle and the reference the command",
+                            reference_step_deg,
+                            trial_step_deg,
+                        )
+                    };
+                let judged = if trial_step_deg > reference_step_deg {
+                    " The reference shows how the ship answers inputs no faster, not steps: a \
+                     slew limit is judged against the reference's own spread, the bootstrap's \
+                     replicates measuring how the model answers steps it never saw."
+                } else {
+                    " The model identified on the reference carries that gear in its dynamics \
+                     and meets it again in the trials' inputs."
+                };
+                format!(
+                    "The {fast} commands change by up to {fast_step:.1}° in one sample, the \
+                     {slow} inputs by {slow_step:.2}° at most ({slew_degps:.1} °/s): where \
+                     {logs}, a steering gear slewing at most about {slew_degps:.1} °/s lies between \
+                     them.{judged} Log the same signal in both sets (`simulate --log-angle` \
+                     logs a simulator's gear angle)."
                 )
             }
             Caveat::OtherManoeuvre { distance, hull } => {

@@ -161,9 +161,171 @@ pub(super) fn other_manoeuvre(est: &[Record], reference: &[Record]) -> Option<Ca
     })
 }
 
+/// Ratio of the trials' largest one-sample command change to the reference's from which
+/// [`command_steps`] says the trials' commands step where the reference's inputs never
+/// do. Commands sailed by `simulate` step by 40° (PRBS, ±20° zig-zags) or 20° (the
+/// autopilot) on every world, so any two kinds lie within 2 of each other; a rudder angle
+/// logged by a steering gear of 16 °/s at 0.15 s moves 2.45° a sample (HSVA's KVLCC2
+/// model), 4 to 29 times less than the steps of its zig-zags' commands of ±5–35°.
+pub(super) const STEP_RATIO: f64 = 3.0;
+
+/// The caveat for one set whose commands step where the other's inputs never move so fast
+/// ([`Caveat::CommandSteps`]): the largest change of δ over one sample of each set, given
+/// where one is [`STEP_RATIO`] times the other's or more (`ts`: the sample time, s); `None`
+/// without a reference or where either set's inputs never move.
+pub(super) fn command_steps(est: &[Record], reference: &[Record], ts: f64) -> Option<Caveat> {
+    let largest = |recs: &[Record]| {
+        recs.iter()
+            .flat_map(|r| r.u.windows(2).map(|w| (w[1] - w[0]).abs()))
+            .filter(|d| d.is_finite())
+            .fold(0.0, f64::max)
+    };
+    let (trial_step_deg, reference_step_deg) = (largest(est), largest(reference));
+    let slower = trial_step_deg.min(reference_step_deg);
+    (slower > 0.0 && trial_step_deg.max(reference_step_deg) >= STEP_RATIO * slower).then_some(
+        Caveat::CommandSteps {
+            trial_step_deg,
+            reference_step_deg,
+            slew_degps: slower / ts,
+        },
+    )
+}
+
+/// Whether `c` is a [`Caveat::CommandSteps`] whose trials step (a slew limit is then judged
+/// by [`slew_on_spread`]).
+pub(super) fn trials_step(c: Option<&Caveat>) -> bool {
+    matches!(c, Some(Caveat::CommandSteps { trial_step_deg, reference_step_deg, .. })
+        if trial_step_deg > reference_step_deg)
+}
+
+/// A slew limit judged where the trials' commands step and the reference's inputs never do
+/// ([`command_steps`]): against the reference's own spread (its parts measured against each
+/// other) alone, where that gives the smaller p. The bootstrap's replicates simulate the
+/// model on the trials' steps and re-identify it on the reference's inputs, which never
+/// show how the ship answers a step; so they measure that ignorance — on HSVA's KVLCC2
+/// model, a slew limit reached D = 28 199 in one replicate of 40, and 0 in 22 — and not the
+/// steering gear, which the reference's inputs show by never moving faster than it.
+pub(super) fn slew_on_spread(e: &mut super::verdict::Evidence, nulls: &super::null::Nulls) {
+    let Some(spread) = nulls.spread.as_deref().map(super::null::Null::fit) else {
+        return;
+    };
+    let p = spread.p(e.statistic);
+    if p < e.p_yaw {
+        e.words.push_str(&format!(
+            " (p {} against the reference's own spread alone: the trials' commands step where \
+             the reference's inputs never move so fast, so the bootstrap, {}, measures how a \
+             model identified on the reference answers a step it never saw)",
+            super::verdict::fmt_p(p),
+            super::verdict::fmt_p(e.p_yaw),
+        ));
+        e.null = spread;
+        e.score = spread.excess(e.statistic);
+        e.p = p;
+        e.p_yaw = p;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_reference_that_never_steps_judges_a_slew_limit_on_its_own_spread() {
+        let rec = |u: Vec<f64>| Record::from_uy("r", 0.125, u.clone(), vec![0.0; u.len()]);
+        // ±20° zig-zag commands, and the rudder angle a gear of 2.5° a sample makes of them
+        let cmd: Vec<f64> = (0..400)
+            .map(|i| if (i / 50) % 2 == 0 { 20.0 } else { -20.0 })
+            .collect();
+        let mut angle = vec![0.0];
+        for c in &cmd[1..] {
+            let a: f64 = angle[angle.len() - 1];
+            angle.push(a + (c - a).clamp(-2.5, 2.5));
+        }
+        let c = command_steps(&[rec(cmd.clone())], &[rec(angle.clone())], 0.125).unwrap();
+        let Caveat::CommandSteps {
+            trial_step_deg,
+            reference_step_deg,
+            slew_degps,
+        } = c
+        else {
+            panic!("{c:?}");
+        };
+        assert_eq!((trial_step_deg, reference_step_deg), (40.0, 2.5));
+        assert_eq!(slew_degps, 20.0);
+        assert!(
+            c.explain().contains("up to 40.0° in one sample"),
+            "{}",
+            c.explain()
+        );
+        assert!(
+            c.explain().contains("2.50° at most (20.0 °/s)"),
+            "{}",
+            c.explain()
+        );
+        let json = serde_json::to_value(&c).unwrap();
+        assert_eq!(json["caveat"], "command-steps");
+        assert_eq!(json["reference_step_deg"], 2.5);
+        assert!(trials_step(Some(&c)));
+        // steps in the reference, the angle in the trials: the same figures the other way
+        // round, and no slew limit judged on the spread
+        let r = command_steps(&[rec(angle.clone())], &[rec(cmd.clone())], 0.125).unwrap();
+        assert!(r
+            .explain()
+            .starts_with("The reference's commands change by up to 40.0°"));
+        assert!(r
+            .explain()
+            .contains("where the trials log the rudder/pod angle"));
+        assert!(!trials_step(Some(&r)) && !trials_step(None));
+        // commands against commands: none
+        let prbs: Vec<f64> = (0..400).map(|i| [5.0, -15.0, 20.0][(i / 7) % 3]).collect();
+        assert!(command_steps(&[rec(cmd.clone())], &[rec(prbs)], 0.125).is_none());
+        assert!(command_steps(&[rec(cmd.clone())], &[], 0.125).is_none());
+        // a set that never moves: nothing to compare with
+        assert!(command_steps(&[rec(cmd.clone())], &[rec(vec![5.0; 400])], 0.125).is_none());
+        assert!(command_steps(&[rec(vec![5.0; 400])], &[rec(cmd)], 0.125).is_none());
+
+        // a slew limit whose bootstrap is wide (the model answering steps it never saw)
+        // and the reference's parts alike: judged on the spread, and the words say why
+        let d = 30_000.0;
+        let mut e = crate::diagnose::tests::evidence(EffectKind::RateLimit, 5.6e-3, 5.6e-3, false);
+        e.statistic = d;
+        let boot: Vec<f64> = (0..40)
+            .map(|i| {
+                if i % 2 == 0 {
+                    0.0
+                } else {
+                    3000.0 * (i % 7) as f64
+                }
+            })
+            .collect();
+        let nulls = super::super::null::Nulls {
+            boot: boot.clone(),
+            spread: Some(vec![81.0, 0.0, 0.0, 0.0]),
+        };
+        slew_on_spread(&mut e, &nulls);
+        let spread = super::super::null::Null::fit(&[81.0, 0.0, 0.0, 0.0]);
+        assert_eq!(e.p.to_bits(), spread.p(d).to_bits());
+        assert!(e.p < 1e-12, "{}", e.p);
+        assert_eq!(
+            (e.p_yaw.to_bits(), e.score.to_bits()),
+            (e.p.to_bits(), spread.excess(d).to_bits())
+        );
+        assert!(
+            e.words.contains("against the reference's own spread alone"),
+            "{}",
+            e.words
+        );
+        // where the spread gives the larger p, nothing changes
+        let mut e2 = crate::diagnose::tests::evidence(EffectKind::RateLimit, 1e-200, 1e-200, false);
+        e2.statistic = d;
+        slew_on_spread(&mut e2, &nulls);
+        assert_eq!((e2.p, e2.words.as_str()), (1e-200, ""));
+        // no spread (an effect with a free gain, or a reference too short to cut): none
+        let mut e3 = crate::diagnose::tests::evidence(EffectKind::RateLimit, 5.6e-3, 5.6e-3, false);
+        e3.statistic = d;
+        slew_on_spread(&mut e3, &super::super::null::Nulls { boot, spread: None });
+        assert_eq!(e3.p, 5.6e-3);
+    }
 
     #[test]
     fn the_commands_say_what_the_records_cannot_tell() {

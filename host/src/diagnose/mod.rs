@@ -485,6 +485,7 @@ fn run(
     // trials sailed with other commands than the reference: the nulls simulate the hull
     // physics the reference shows of its own, on both sets' commands (module docs)
     let mut other = commands::other_manoeuvre(est, reference);
+    let steps = commands::command_steps(est, reference, model.ts);
     let hull = other
         .as_ref()
         .and_then(|_| reference_hull(base, reference, cfg))
@@ -519,6 +520,9 @@ fn run(
         .enumerate()
         .map(|(i, &kind)| {
             let mut e = effect_evidence(base, kind, &real[i], &nulls[i], has_ref, cfg, &ch);
+            if kind == EffectKind::RateLimit && commands::trials_step(steps.as_ref()) {
+                commands::slew_on_spread(&mut e, &nulls[i]);
+            }
             // (a quicker estimate's own words name the reference's gear already)
             if let Some(own) = base
                 .effect(kind)
@@ -733,7 +737,7 @@ fn run(
     caveats.extend(commands::clip_or_dead_band(&named, est, damping));
     caveats.extend(commands::asymmetry_or_bias(&named, est));
     caveats.extend(commands::slew_or_dead_time(&named, est));
-    caveats.extend(other);
+    caveats.extend(steps.into_iter().chain(other));
     let then = then.map(|(e, _)| e.kind.name().to_string());
     if then.as_deref() == Some(EffectKind::Current.name()) {
         // a current named second: what speed over ground cannot show does not qualify it
