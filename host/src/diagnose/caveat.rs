@@ -551,41 +551,7 @@ impl Caveat {
                 trial_step_deg,
                 reference_step_deg,
                 slew_degps,
-            } => {
-                let (fast, slow, logs, fast_step, slow_step) =
-                    if trial_step_deg > reference_step_deg {
-                        (
-                            "trials'",
-                            "reference's",
-                            "the reference logs the rudder/pod angle and the trials the command",
-                            trial_step_deg,
-                            reference_step_deg,
-                        )
-                    } else {
-                        (
-                            "reference's",
-                            "trials'",
-                            "the trials log the rudder/pod angle and the reference the command",
-                            reference_step_deg,
-                            trial_step_deg,
-                        )
-                    };
-                let judged = if trial_step_deg > reference_step_deg {
-                    " The reference shows how the ship answers inputs no faster, not steps: a \
-                     slew limit is judged against the reference's own spread, the bootstrap's \
-                     replicates measuring how the model answers steps it never saw."
-                } else {
-                    " The model identified on the reference carries that gear in its dynamics \
-                     and meets it again in the trials' inputs."
-                };
-                format!(
-                    "The {fast} commands change by up to {fast_step:.1}° in one sample, the \
-                     {slow} inputs by {slow_step:.2}° at most ({slew_degps:.1} °/s): where \
-                     {logs}, a steering gear slewing at most about {slew_degps:.1} °/s lies between \
-                     them.{judged} Log the same signal in both sets (`simulate --log-angle` \
-                     logs a simulator's gear angle)."
-                )
-            }
+            } => super::commands::steps_words(*trial_step_deg, *reference_step_deg, *slew_degps),
             Caveat::OtherManoeuvre { distance, hull } => {
                 let nulls = if hull.is_empty() {
                     "The reference records show no hull physics of their own that the null \

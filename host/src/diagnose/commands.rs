@@ -191,6 +191,43 @@ pub(super) fn command_steps(est: &[Record], reference: &[Record], ts: f64) -> Op
     )
 }
 
+/// The words of [`Caveat::CommandSteps`]: each set's largest change over one sample (deg)
+/// and the slower one's over the sample time (deg/s).
+pub(super) fn steps_words(trial_step_deg: f64, reference_step_deg: f64, slew_degps: f64) -> String {
+    let (fast, slow, logs, fast_step, slow_step) = if trial_step_deg > reference_step_deg {
+        (
+            "trials'",
+            "reference's",
+            "the reference logs the rudder/pod angle and the trials the command",
+            trial_step_deg,
+            reference_step_deg,
+        )
+    } else {
+        (
+            "reference's",
+            "trials'",
+            "the trials log the rudder/pod angle and the reference the command",
+            reference_step_deg,
+            trial_step_deg,
+        )
+    };
+    let judged = if trial_step_deg > reference_step_deg {
+        " The reference shows how the ship answers inputs no faster, not steps: a \
+         slew limit is judged against the reference's own spread, the bootstrap's \
+         replicates measuring how the model answers steps it never saw."
+    } else {
+        " The model identified on the reference carries that gear in its dynamics \
+         and meets it again in the trials' inputs."
+    };
+    format!(
+        "The {fast} commands change by up to {fast_step:.1}° in one sample, the \
+         {slow} inputs by {slow_step:.2}° at most ({slew_degps:.1} °/s): where \
+         {logs}, a steering gear slewing at most about {slew_degps:.1} °/s lies between \
+         them.{judged} Log the same signal in both sets (`simulate --log-angle` \
+         logs a simulator's gear angle)."
+    )
+}
+
 /// Whether `c` is a [`Caveat::CommandSteps`] whose trials step (a slew limit is then judged
 /// by [`slew_on_spread`]).
 pub(super) fn trials_step(c: Option<&Caveat>) -> bool {

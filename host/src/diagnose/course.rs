@@ -224,6 +224,32 @@ pub(super) fn widest_span(courses: &[f64]) -> f64 {
 mod tests {
     use super::*;
 
+    #[test]
+    fn courses_closer_than_the_records_swing_are_one_course() {
+        // headings swinging ±20° (a standard deviation of 20°) about course `c`
+        let zz = |c: f64| {
+            let psi: Vec<f64> = (0..400)
+                .map(|i| c + if (i / 50) % 2 == 0 { 20.0 } else { -20.0 })
+                .collect();
+            let mut r = Record::from_uy("r", 1.0, vec![0.0; 400], vec![0.0; 400]);
+            r.psi = Some(psi);
+            r
+        };
+        let tank = [zz(-1.8), zz(0.5), zz(1.7)];
+        let courses = [-1.8, 0.5, 1.7];
+        assert!((widest_span(&courses) - 3.5).abs() < 1e-12);
+        assert!(!set_apart(widest_span(&courses), &tank));
+        // courses 98° apart, as the suite's seeds set them: set apart
+        let sea = [zz(10.0), zz(60.0), zz(108.0)];
+        assert!(set_apart(widest_span(&[10.0, 60.0, 108.0]), &sea));
+        // the edge: the median swing is the records' standard deviation, 20°
+        assert!(set_apart(20.0, &tank) && !set_apart(19.99, &tank));
+        // a record without heading: no reading
+        let mut blind = sea.to_vec();
+        blind[1].psi = None;
+        assert!(!set_apart(98.0, &blind));
+    }
+
     /// Errors `offset + slope·x` plus a deterministic noise of std ≈ 0.01 on headings that
     /// swing ±0.35 rad about the course.
     fn piece(offset: f64, slope: f64, seed: u64) -> (Vec<f64>, Vec<f64>) {
