@@ -281,8 +281,8 @@ fn gls(ms: &[(Mean, DMatrix<f64>)], current: bool) -> Option<(DVector<f64>, DMat
 /// [`CarryEvidence`] of the trials `est` against `reference`: both lanes where every record
 /// logs course over ground, else speed over ground alone. `None` with fewer than two trial
 /// records, a record without heading or speed or too short, courses too alike to tell a
-/// current or not [`set_apart`], or a reference that cannot calibrate it: fewer than two records, or records
-/// that do not each hold one course ([`heading_separation`] at least
+/// current or not [`set_apart`], or a reference that cannot calibrate it: fewer than two
+/// records, or records that do not each hold one course ([`heading_separation`] at least
 /// [`MIN_HEADING_SEPARATION`]). A record's mean speed depends on its manoeuvre: PRBS
 /// records of KVLCC2, each with its own sequence, differ by 56 000 times the noise their
 /// alike zig-zags show.

@@ -162,8 +162,8 @@ pub enum Caveat {
         hull: Vec<String>,
     },
     /// One set's commands step where the other's inputs never move so fast: its largest
-    /// change over one sample is [`super::commands::STEP_RATIO`] times the other's or more
-    /// (one set logs the rudder's angle, the other the command). The set that never steps
+    /// change over one sample is 3 times the other's or more (one set logs the rudder's
+    /// angle, the other the command). The set that never steps
     /// cannot show how the ship answers a step, and a steering gear lies between the two:
     /// where the trials step, a slew limit is judged against the reference's own spread.
     CommandSteps {

@@ -161,9 +161,8 @@ pub(super) fn other_manoeuvre(est: &[Record], reference: &[Record]) -> Option<Ca
     })
 }
 
-/// Ratio of the trials' largest one-sample command change to the reference's from which
-/// [`command_steps`] says the trials' commands step where the reference's inputs never
-/// do. Commands sailed by `simulate` step by 40° (PRBS, ±20° zig-zags) or 20° (the
+/// Ratio of one set's largest one-sample command change to the other's from which
+/// [`command_steps`] says that set's commands step where the other's inputs never do. Commands sailed by `simulate` step by 40° (PRBS, ±20° zig-zags) or 20° (the
 /// autopilot) on every world, so any two kinds lie within 2 of each other; a rudder angle
 /// logged by a steering gear of 16 °/s at 0.15 s moves 2.45° a sample (HSVA's KVLCC2
 /// model), 4 to 29 times less than the steps of its zig-zags' commands of ±5–35°.
