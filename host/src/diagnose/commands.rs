@@ -97,6 +97,13 @@ fn commonest(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
 /// puts at most a third of its changes at one size (the three test worlds).
 const ONE_STEP_SHARE: f64 = 0.5;
 
+/// The command's changes |Δδ| between consecutive samples of `recs` (deg), the finite ones.
+fn changes(recs: &[Record]) -> impl Iterator<Item = f64> + '_ {
+    recs.iter()
+        .flat_map(|r| r.u.windows(2).map(|w| (w[1] - w[0]).abs()))
+        .filter(|d| d.is_finite())
+}
+
 /// The caveat for a slew limit or a dead time named on command changes of one size
 /// ([`Caveat::SlewOrDeadTime`]): `named`, the verdict's effect and its second; `est`, the
 /// trials. The size is the commonest |Δδ| between samples ([`commonest`]); the changes
@@ -109,11 +116,7 @@ pub(super) fn slew_or_dead_time(named: &[EffectKind], est: &[Record]) -> Option<
     {
         return None;
     }
-    let changes: Vec<f64> = est
-        .iter()
-        .flat_map(|r| r.u.windows(2).map(|w| (w[1] - w[0]).abs()))
-        .filter(|d| d.is_finite())
-        .collect();
+    let changes: Vec<f64> = changes(est).collect();
     let largest = changes.iter().copied().fold(0.0, f64::max);
     let commands = changes.into_iter().filter(|d| *d >= 0.1 * largest);
     let (step_deg, share) = commonest(commands).filter(|(_, share)| *share >= ONE_STEP_SHARE)?;
@@ -173,12 +176,7 @@ pub(super) const STEP_RATIO: f64 = 3.0;
 /// where one is [`STEP_RATIO`] times the other's or more (`ts`: the sample time, s); `None`
 /// without a reference or where either set's inputs never move.
 pub(super) fn command_steps(est: &[Record], reference: &[Record], ts: f64) -> Option<Caveat> {
-    let largest = |recs: &[Record]| {
-        recs.iter()
-            .flat_map(|r| r.u.windows(2).map(|w| (w[1] - w[0]).abs()))
-            .filter(|d| d.is_finite())
-            .fold(0.0, f64::max)
-    };
+    let largest = |recs: &[Record]| changes(recs).fold(0.0, f64::max);
     let (trial_step_deg, reference_step_deg) = (largest(est), largest(reference));
     let slower = trial_step_deg.min(reference_step_deg);
     (slower > 0.0 && trial_step_deg.max(reference_step_deg) >= STEP_RATIO * slower).then_some(

@@ -194,19 +194,9 @@ pub(super) fn set_apart(span_deg: f64, recs: &[Record]) -> bool {
             Some((psi.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / n).sqrt())
         })
         .collect();
-    match swings {
-        Some(mut s) if !s.is_empty() => {
-            s.sort_by(f64::total_cmp);
-            let k = s.len();
-            let median = if k % 2 == 1 {
-                s[k / 2]
-            } else {
-                0.5 * (s[k / 2 - 1] + s[k / 2])
-            };
-            span_deg >= median
-        }
-        _ => false,
-    }
+    swings
+        .and_then(|mut s| crate::identify::track::median(&mut s))
+        .is_some_and(|median| span_deg >= median)
 }
 
 /// The widest angle (deg, 0–180) between two of `courses` (deg).
