@@ -280,7 +280,7 @@ fn kvlcc2_set(dir: &std::path::Path, name: &str, seed: &str, extra: &[&str]) -> 
         .collect()
 }
 
-/// The verdict and the `command-steps` caveat of `diagnose` on `trials` against `refs`.
+/// The JSON `diagnose` writes on `trials` against `refs` with `model` (seed 1).
 fn diagnose_on(
     dir: &std::path::Path,
     model: &str,
@@ -363,4 +363,5 @@ fn a_reference_that_logs_the_gears_angle_names_the_gear_the_commands_pass() {
         "{}",
         v["caveats"]
     );
+    let _ = std::fs::remove_dir_all(&d);
 }
