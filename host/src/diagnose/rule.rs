@@ -7,6 +7,7 @@ use std::collections::BTreeMap;
 use yawcast_shared::model::EffectKind;
 
 use super::verdict::Evidence;
+use crate::effects::Role;
 
 /// Held-out fit % keyed by horizon ("1","5","10","20","sim").
 pub(super) type Fits = BTreeMap<String, f64>;
@@ -89,7 +90,11 @@ pub(super) const GAIN_PP: f64 = 1.0;
 /// never named ahead of a significant effect that does (≥ [`GAIN_PP`] at its own horizon,
 /// where its statistic is judged), whatever their statistics — a sensor offset its own
 /// channel shows, with nothing to win back in the prediction, becomes a note behind the
-/// effect that does. The first such effect behind the first material one moves ahead of it
+/// effect that does. Behind a sensor offset ([`Role::Output`]: the gyro's, which changes no
+/// physics the model predicts) a material effect that gains [`GAIN_PP`] at any horizon
+/// counts: MARIN's KVLCC2 records against a simulator of the hull, the gyro 0.005 °/s off
+/// the heading's turn (−0.05 / −1.26 pp at 10 steps / in simulation), were named
+/// `gyro-bias` ahead of the hull's damping (+0.75 / +9.90 pp). The first such effect behind the first material one moves ahead of it
 /// (`gains[i]`: held-out gain and fits of the significant effects, in the order of `ev`;
 /// `before`: the held-out fits without an effect). Returns the effect passed over, if any.
 ///
@@ -108,14 +113,25 @@ pub(super) fn gain_before_statistic(
     if gi >= NO_GAIN_PP {
         return None;
     }
-    let j = (i + 1..ev.len()).find(|&j| gain_of(&gains[j]).is_some_and(|v| v >= GAIN_PP))?;
-    let gj = gain_of(&gains[j]).unwrap_or(0.0);
+    let sensor = matches!(crate::effects::def(ev[i].kind).role, Role::Output);
+    let own = |j: usize| gain_of(&gains[j]).filter(|&v| v >= GAIN_PP);
+    // a sensor offset changes no physics the model predicts: any horizon where a material
+    // effect behind it gains counts
+    let any = |j: usize| {
+        best_gain(&gains[j], before)
+            .filter(|&v| sensor && v >= GAIN_PP && is_material(ev, gains, j))
+    };
+    let (j, gj, at) = (i + 1..ev.len()).find_map(|j| {
+        own(j)
+            .map(|g| (j, g, "at its own horizon"))
+            .or_else(|| any(j).map(|g| (j, g, "at one horizon, the offset being a sensor's")))
+    })?;
     let words = format!(
         "; named behind {} (a note, not the verdict): it improves held-out prediction by \
          {gi:+.1} pp at most (at 10 steps or in simulation), where {} is significant and \
          improves it by {gj:+.1} pp — an effect that does not improve prediction \
          (< {NO_GAIN_PP} pp at either) is never named ahead of one that does (≥ {GAIN_PP} pp \
-         at its own horizon)",
+         {at})",
         ev[j].kind.name(),
         ev[j].kind.name(),
     );
@@ -515,5 +531,28 @@ mod tests {
         ];
         assert_eq!(gain_before_statistic(&mut ev, &mut gains, &before), None);
         assert_eq!(ev[0].kind, EffectKind::Wind);
+        // behind a sensor offset any horizon counts: MARIN's KVLCC2 records against the
+        // simulator, the gyro 0.005 °/s off the heading (−0.05 / −1.26 pp), the hull's
+        // damping +0.75 / +9.90 pp — and not behind an effect that is not material
+        let run = |damping_material: bool| {
+            let mut ev = vec![
+                evidence(EffectKind::GyroBias, 1.2e-4, 1.2e-4, true),
+                evidence(EffectKind::NonlinearDamping, 1e-16, 1e-16, false),
+            ];
+            let g = if damping_material { 0.75 } else { -0.2 };
+            let mut gains = vec![
+                held_out(&before, -0.05, -1.26, -1.26),
+                held_out(&before, g, 9.90, g),
+            ];
+            let passed = gain_before_statistic(&mut ev, &mut gains, &before);
+            (passed, ev[0].kind, ev[1].words.clone())
+        };
+        let (passed, first, words) = run(true);
+        assert_eq!(passed, Some(EffectKind::GyroBias));
+        assert_eq!(first, EffectKind::NonlinearDamping);
+        assert!(words.contains("improves it by +9.9 pp"), "{words}");
+        assert!(words.contains("the offset being a sensor's"), "{words}");
+        assert_eq!(run(false).0, None);
+        assert_eq!(run(false).1, EffectKind::GyroBias);
     }
 }
