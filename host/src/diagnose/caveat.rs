@@ -175,6 +175,19 @@ pub enum Caveat {
         /// set's inputs move.
         slew_degps: f64,
     },
+    /// The model's 10-step prediction carries white noise on the yaw rate many times over,
+    /// and the trials' noise (far above the reference's) so carried is what their 10-step
+    /// errors are (`noise.rs`).
+    NoiseGain {
+        /// [`crate::identify::predict::noise_gain`] at 10 steps.
+        gain_10: f64,
+        /// The white noise on the trials' yaw rate, from its fourth differences (°/s).
+        trials_noise_degps: f64,
+        /// The trials' 10-step error (°/s).
+        trials_ten_step_degps: f64,
+        /// The white noise on the reference's yaw rate (°/s).
+        reference_noise_degps: f64,
+    },
     /// The trials ran at another speed than the reference, by [`OTHER_SPEED`] or more of
     /// the reference's: a hull's rudder gain and time constants change with speed through
     /// the water, which the library's effects can only mimic. Either the difference exceeds
@@ -552,6 +565,7 @@ impl Caveat {
                 reference_step_deg,
                 slew_degps,
             } => super::commands::steps_words(*trial_step_deg, *reference_step_deg, *slew_degps),
+            Caveat::NoiseGain { .. } => super::noise::words(self),
             Caveat::OtherManoeuvre { distance, hull } => {
                 let nulls = if hull.is_empty() {
                     "The reference records show no hull physics of their own that the null \

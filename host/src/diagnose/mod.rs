@@ -106,6 +106,7 @@ mod commands;
 pub mod compare;
 mod course;
 mod evidence;
+mod noise;
 mod null;
 mod reference;
 pub mod resid;
@@ -738,6 +739,7 @@ fn run(
     caveats.extend(commands::asymmetry_or_bias(&named, est));
     caveats.extend(commands::slew_or_dead_time(&named, est));
     caveats.extend(steps.into_iter().chain(other));
+    caveats.extend(noise::noise_gain(base, est, reference));
     let then = then.map(|(e, _)| e.kind.name().to_string());
     if then.as_deref() == Some(EffectKind::Current.name()) {
         // a current named second: what speed over ground cannot show does not qualify it

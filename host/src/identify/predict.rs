@@ -263,6 +263,77 @@ pub fn k_step(model: &Model, rec: &Record, x0: &[f64], k: usize) -> Vec<f64> {
     k_steps(model, rec, x0, &[k]).pop().unwrap_or_default()
 }
 
+/// The k-step prediction's gain on measurement noise: how far a unit white noise on the
+/// measured yaw rate moves `ŷ(t|t−k)`, `√Σⱼ hⱼ²` with `hⱼ = C Aᵏ⁻¹ (A − K C)ʲ K` (the
+/// linear part; effects aside). About 1 or less where the Kalman gain passes the latest
+/// measurement on through the hull's dynamics; far above 1 where it extrapolates the shape
+/// of the last few measurements, which records smoother than any rate gyro's (a filtered or
+/// differentiated yaw rate) teach it: white noise on another gyro is then carried that many
+/// times over. `f64::INFINITY` where `A − K C` is not stable.
+///
+/// ```
+/// use yawcast::identify::{model::Model, predict};
+/// // A = [[0, 1], [0, 0.5]], K = [0.5, 0.25]: (A − KC) K = 0, so at two steps only
+/// // h₀ = C A K = 0.25, at one step C K = 0.5
+/// let m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.5, 0.25]).unwrap();
+/// assert_eq!(predict::noise_gain(&m, 2), 0.25);
+/// assert_eq!(predict::noise_gain(&m, 1), 0.5);
+/// // K = [1, 0]: (A − KC) K = [−1, 0], (A − KC)² K = [1, 0], … — not stable
+/// let m = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![1.0, 0.0]).unwrap();
+/// assert_eq!(predict::noise_gain(&m, 1), f64::INFINITY);
+/// let sim = Model::new(1.0, vec![0.0, 0.5], vec![0.1, 0.2], vec![0.0, 0.0]).unwrap();
+/// assert_eq!(predict::noise_gain(&sim, 10), 0.0);
+/// ```
+pub fn noise_gain(model: &Model, k: usize) -> f64 {
+    use crate::identify::pem::poly;
+    let n = model.n;
+    if n > MAX_N {
+        return f64::INFINITY;
+    }
+    let mut p = [0.0; MAX_N + 1];
+    poly::predictor_poly(&model.a, &model.k, &mut p);
+    if !poly::roots_within(&p, n, poly::MAX_RADIUS) {
+        return f64::INFINITY;
+    }
+    // A x for the companion form: a shift, the last row Σ aᵢ xᵢ
+    let a_times = |x: &[f64]| -> Vec<f64> {
+        let mut out: Vec<f64> = x[1..].to_vec();
+        out.push(model.a.iter().zip(x).map(|(a, v)| a * v).sum());
+        out
+    };
+    // the row C Aᵏ⁻¹, one basis vector at a time
+    let row: Vec<f64> = (0..n)
+        .map(|i| {
+            let mut x = vec![0.0; n];
+            x[i] = 1.0;
+            for _ in 1..k.max(1) {
+                x = a_times(&x);
+            }
+            x[0]
+        })
+        .collect();
+    let mut m = model.k.clone();
+    let mut sum = 0.0;
+    for _ in 0..1_000_000 {
+        let h: f64 = row.iter().zip(&m).map(|(r, v)| r * v).sum();
+        sum += h * h;
+        // (A − K C) m
+        let first = m[0];
+        m = a_times(&m);
+        for (mi, ki) in m.iter_mut().zip(&model.k) {
+            *mi -= ki * first;
+        }
+        let size: f64 = m.iter().map(|v| v * v).sum();
+        if !size.is_finite() || size > 1e30 {
+            return f64::INFINITY;
+        }
+        if size < 1e-30 * sum.max(1e-300) || size == 0.0 {
+            break;
+        }
+    }
+    sum.sqrt()
+}
+
 /// Predictions at several horizons in one pass: `out[i][t] = ŷ(t|t−horizons[i])`, the same
 /// numbers [`k_step`] gives for each horizon (horizons 0 count as 1). Costs one pass of
 /// `max(horizons)` open-loop steps per sample instead of one per horizon.
