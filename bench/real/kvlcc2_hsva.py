@@ -10,23 +10,31 @@ redistribute them: `bench/real/hsva.sh` fetches them and runs this script at ben
 
 Usage (Python 3 standard library only):
 
-    python3 bench/real/kvlcc2_hsva.py SOURCE_DIR OUT_DIR [--every N] [--command]
+    python3 bench/real/kvlcc2_hsva.py SOURCE_DIR OUT_DIR [--every N] [--command] [--froude S]
+                                      [--rate-digits D]
 
 What it does to each record, in this order:
-1. reads the 12 columns (time s, x0 m, y0 m, heading deg, u m/s, v m/s, yaw rate deg/s, roll
-   rate, rudder angle deg, propeller rps, thrust N, torque Nm; 20 Hz) after the 4 title lines;
+1. reads the 12 columns (time s, x0 m, y0 m, heading deg, the ground velocity's x and y in
+   the earth frame m/s (the catalog's `u` and `v`: they are the positions' derivative, not
+   the ship-frame velocities), yaw rate deg/s, roll rate, rudder angle deg, propeller rps,
+   thrust N, torque Nm; 20 Hz) after the 4 title lines;
    the title's third line names the zig-zag (`Z20/5`: rudder 20°, heading 5°);
-2. checks that the yaw rate is the heading's derivative (slope 1 within 2 %) and that the
-   rudder reaches the amplitude the file name gives (within 0.2°);
+2. checks that the yaw rate is the heading's derivative (slope 1 within 2 %), that the ground
+   velocity is the positions' derivative (within 3 %) and that the rudder reaches the
+   amplitude the file name gives (within 0.2°);
 3. keeps every N-th row (default 3: 20 Hz -> 6.67 Hz, Ts 0.15 s, the sample time of
    `simulate --world kvlcc2 --scale 7`);
 4. converts to yawcast's signs: the source's rudder is negative to turn to starboard (its yaw
    rate is positive to starboard, as yawcast's), so `delta_deg` = −rudder; speed over ground =
-   hypot(u, v) (a towing tank has no current); course over ground = heading + atan2(v, u);
+   hypot(u, v) (a towing tank has no current); course over ground = atan2(v, u);
    with `--command`, `delta_deg` is instead the zig-zag's command: ±amplitude from the sample
    where the measured rudder starts moving towards it (0 before the first), so the steering
    gear's rate is left to the records;
-5. writes `t_s,delta_deg,r_degps,psi_deg,u_mps,cog_deg` to OUT_DIR/<name>.csv, name
+5. with `--froude S` (the scale, 45.7), Froude-scales the record to the ship: times × √S,
+   yaw rate ÷ √S, speed × √S (angles as they are), to set beside records given at full
+   scale (MARIN's: `--every 2 --froude 45.7` gives their Ts, 0.676 s); with `--rate-digits
+   D`, writes the yaw rate to D significant figures, as MARIN's records give it (3);
+6. writes `t_s,delta_deg,r_degps,psi_deg,u_mps,cog_deg` to OUT_DIR/<name>.csv, name
    `z<rudder>_<heading>[_p|_s]` (e.g. `z20_05`, `z10_10_p`), and prints per record its rows,
    length, mean speed and the rudder's largest rate (deg/s, over one source sample).
 """
@@ -76,6 +84,16 @@ def main():
         i = args.index("--every")
         every = int(args[i + 1])
         del args[i : i + 2]
+    digits = None
+    if "--rate-digits" in args:
+        i = args.index("--rate-digits")
+        digits = int(args[i + 1])
+        del args[i : i + 2]
+    froude = 1.0
+    if "--froude" in args:
+        i = args.index("--froude")
+        froude = math.sqrt(float(args[i + 1]))
+        del args[i : i + 2]
     if len(args) != 2:
         sys.exit(__doc__)
     src, out = args
@@ -99,12 +117,20 @@ def main():
             den += mid * mid
         if abs(num / den - 1.0) > 0.02:
             sys.exit(f"{name}: heading's derivative / yaw rate = {num / den:.3f}, expected 1")
+        num = den = 0.0
+        for a, b in zip(rows[:-20], rows[20:]):
+            gx, gy = (a[4] + b[4]) / 2.0, (a[5] + b[5]) / 2.0
+            dt = b[0] - a[0]
+            num += (b[1] - a[1]) / dt * gx + (b[2] - a[2]) / dt * gy
+            den += gx * gx + gy * gy
+        if abs(num / den - 1.0) > 0.03:
+            sys.exit(f"{name}: positions' derivative / ground velocity = {num / den:.3f}, expected 1")
         peak = max(abs(r[8]) for r in rows)
         if abs(peak - amp) > 0.2:
             sys.exit(f"{name} ({title}): rudder reaches {peak:.2f}°, expected {amp}°")
         rudder = [-r[8] for r in rows]
         cmd = command(rudder, amp) if use_command else rudder
-        slew = max(abs(b - a) for a, b in zip(rudder, rudder[1:])) / ts
+        slew = max(abs(b - a) for a, b in zip(rudder, rudder[1:])) / (ts * froude)
         base = "z{}_{}".format(m.group(1), m.group(2)) + (
             "_" + m.group(3).lower() if m.group(3) else ""
         )
@@ -112,19 +138,22 @@ def main():
         kept = rows[::every]
         cmd = cmd[::every]
         t0 = kept[0][0]
+        def rate(x):
+            return f"{x:.6f}" if digits is None else f"{x:.{digits - 1}e}"
+
         with open(path + ".tmp", "w") as f:
             f.write("t_s,delta_deg,r_degps,psi_deg,u_mps,cog_deg\n")
             for r, d in zip(kept, cmd):
                 u, v = r[4], r[5]
-                cog = (r[3] + math.degrees(math.atan2(v, u))) % 360.0
+                cog = math.degrees(math.atan2(v, u)) % 360.0
                 f.write(
-                    f"{r[0] - t0:.2f},{d:.4f},{r[6]:.5f},{r[3]:.4f},"
-                    f"{math.hypot(u, v):.5f},{cog:.4f}\n"
+                    f"{(r[0] - t0) * froude:.4f},{d:.4f},{rate(r[6] / froude)},{r[3]:.4f},"
+                    f"{math.hypot(u, v) * froude:.5f},{cog:.4f}\n"
                 )
         os.replace(path + ".tmp", path)
-        speed = sum(math.hypot(r[4], r[5]) for r in kept) / len(kept)
+        speed = froude * sum(math.hypot(r[4], r[5]) for r in kept) / len(kept)
         print(
-            f"{base}: {title}, {len(kept)} rows, {kept[-1][0] - t0:.1f} s, "
+            f"{base}: {title}, {len(kept)} rows, {(kept[-1][0] - t0) * froude:.1f} s, "
             f"speed {speed:.3f} m/s, rudder rate up to {slew:.1f} deg/s"
         )
 
