@@ -7,8 +7,9 @@ use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 use yawcast::identify::model::Model;
+use yawcast::identify::{merge, pem, predict};
 use yawcast::io::data::Record;
-use yawcast::{identify::merge, identify::pem, io::export, tune::ga, tune::tables};
+use yawcast::{io::export, tune::ga, tune::tables};
 
 use super::common::{bad, read_model, JsonArg, Outputs, ReadArgs, SeedArg};
 
@@ -216,6 +217,8 @@ pub struct IdentifySummary {
     pub iterations: usize,
     /// One-step fit % per identification record.
     pub fit_identification: Vec<f64>,
+    /// How many times over the 10-step prediction carries white noise on the yaw rate.
+    pub noise_gain_10: f64,
     /// Mean fit % on the validation records per horizon (empty without --validate).
     pub fit: BTreeMap<String, f64>,
     /// Model files written.
@@ -381,13 +384,15 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
         println!("{}", o.describe());
     }
     print_params(&rep.names, &all_params(&model), &rep.std_pct);
+    let noise_gain_10 = predict::noise_gain(&model, 10);
+    println!("{}", predict::noise_gain_words(noise_gain_10));
     let fit = if val.is_empty() {
         BTreeMap::new()
     } else {
         merge::validation_fits(&model, &val)
     };
     if !fit.is_empty() {
-        let s: Vec<String> = yawcast::identify::predict::Horizon::REPORT
+        let s: Vec<String> = predict::Horizon::REPORT
             .iter()
             .filter_map(|h| fit.get(&h.key()).map(|v| format!("{}: {v:.2} %", h.key())))
             .collect();
@@ -424,6 +429,7 @@ pub fn identify(args: &IdentifyArgs) -> Result<()> {
             bic: rep.bic,
             iterations: rep.iterations,
             fit_identification: rep.fit.clone(),
+            noise_gain_10,
             fit,
             model: written,
             identify_s,

@@ -598,7 +598,8 @@ impl Caveat {
                     "Note: {} ({effect}) is significant but does not improve held-out \
                      prediction; by the ranking rule no effect that does not improve prediction \
                      (< {NO_GAIN_PP} pp at 10 steps and in simulation) is named ahead of one \
-                     that does (≥ {GAIN_PP} pp at its own horizon).",
+                     that does (≥ {GAIN_PP} pp at its own horizon; behind a sensor offset, at \
+                     any).",
                     kind.map_or("an effect", effect_phrase)
                 )
             }

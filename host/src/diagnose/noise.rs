@@ -11,11 +11,12 @@ use crate::io::data::Record;
 const HORIZON: usize = 10;
 
 /// A 10-step prediction that carries white noise on the yaw rate this many times over
-/// amplifies it. A predictor that passes the latest measurement on through the hull's
-/// dynamics carries it about once or less: the test worlds' models 0.2–0.3, a model
-/// identified on MARIN's KVLCC2 records (resolved to 3 significant figures) 2.7; one
-/// identified on HSVA's records of the same hull (a yaw rate smooth to 10⁻⁶ °/s) 1 661.
-const AMPLIFIES: f64 = 10.0;
+/// amplifies it ([`predict::NOISE_AMPLIFIES`]). A predictor that passes the latest
+/// measurement on through the hull's dynamics carries it about once or less: the test
+/// worlds' models 0.02–1.45, a model identified on MARIN's KVLCC2 records (resolved to 3
+/// significant figures) 2.7; one identified on HSVA's records of the same hull (a yaw rate
+/// smooth to 10⁻⁶ °/s) 1 661.
+const AMPLIFIES: f64 = predict::NOISE_AMPLIFIES;
 
 /// The trials' noise, for their yaw rate's spread, this many times the reference's or more:
 /// noisier records than the gain was fitted to.
@@ -159,6 +160,17 @@ mod tests {
         assert!((noise - 0.03).abs() < 1.5e-3 && r < 1e-4, "{noise} {r}");
         assert!(gain_10 * noise >= 0.5 * ten, "{noise} {ten}");
         assert!(c.explain().contains("14 times over"), "{}", c.explain());
+        // the JSON fields (docs/cli.md)
+        let v = serde_json::to_value(&c).unwrap();
+        assert_eq!(v["caveat"], "noise-gain");
+        for key in [
+            "gain_10",
+            "trials_noise_degps",
+            "trials_ten_step_degps",
+            "reference_noise_degps",
+        ] {
+            assert!(v[key].as_f64().is_some_and(f64::is_finite), "{key}: {v}");
+        }
         // the same trials through a gain that passes the measurement on: no caveat
         assert_eq!(noise_gain(&plain, &trials, &reference), None);
         // nor on trials as noisy as the reference (the gain meets the noise it was fitted

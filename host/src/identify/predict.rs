@@ -334,6 +334,35 @@ pub fn noise_gain(model: &Model, k: usize) -> f64 {
     sum.sqrt()
 }
 
+/// A gain on measurement noise ([`noise_gain`]) at and above which the k-step prediction
+/// amplifies white noise on the yaw rate: `identify` warns, and `diagnose` checks the trials'
+/// noise against it (caveat `noise-gain`).
+pub const NOISE_AMPLIFIES: f64 = 10.0;
+
+/// `identify`'s line on [`noise_gain`] at 10 steps, with a warning from
+/// [`NOISE_AMPLIFIES`] on.
+///
+/// ```
+/// use yawcast::identify::predict::noise_gain_words;
+/// assert!(noise_gain_words(0.3).starts_with("10-step noise gain 0.30"));
+/// assert!(noise_gain_words(1661.0).contains("warning"));
+/// ```
+pub fn noise_gain_words(gain: f64) -> String {
+    let line = format!(
+        "10-step noise gain {gain:.2}: white noise of σ on the measured yaw rate moves the \
+         10-step prediction by {gain:.2}·σ"
+    );
+    if gain < NOISE_AMPLIFIES {
+        return line;
+    }
+    format!(
+        "{line}; warning: the Kalman gain extrapolates the last few measurements, as records \
+         smoother than a rate gyro's output teach it (a filtered or differentiated yaw rate, or \
+         one written to many decimals): on a gyro as noisy as most, its predictions carry that \
+         noise {gain:.0} times over. Identify on records logged as the controller will see them"
+    )
+}
+
 /// Predictions at several horizons in one pass: `out[i][t] = ŷ(t|t−horizons[i])`, the same
 /// numbers [`k_step`] gives for each horizon (horizons 0 count as 1). Costs one pass of
 /// `max(horizons)` open-loop steps per sample instead of one per horizon.

@@ -249,9 +249,13 @@ fn identify_average_export_compare_chain() {
         "start",
         "start_choice",
         "offset",
+        "noise_gain_10",
     ] {
         assert!(v.get(k).is_some(), "identify JSON lacks `{k}`");
     }
+    // a model identified on a simulator's records passes the latest measurement on
+    let g = v["noise_gain_10"].as_f64().unwrap();
+    assert!(g > 0.0 && g < 10.0, "{v}");
     assert!(v["fit"]["5"].as_f64().unwrap() > 95.0, "{v}");
     // a linear record: every start ends in the one minimum, the lowest cost is taken
     assert!(v["start_choice"].is_null(), "{v}");
