@@ -1,6 +1,6 @@
 //! The model's gain on measurement noise against the trials' own noise: the caveat
-//! [`Caveat::NoiseGain`] where the trials' one-step error, carried by the Kalman gain, is
-//! what their 10-step errors are.
+//! [`Caveat::NoiseGain`] where the trials' noise, carried by a Kalman gain fitted to smoother
+//! records, is what their 10-step errors are.
 
 use super::caveat::Caveat;
 use super::evidence::Set;

@@ -85,16 +85,16 @@ pub(super) const NO_GAIN_PP: f64 = 0.5;
 /// Held-out gain (pp) at and above which an effect counts as improving prediction.
 pub(super) const GAIN_PP: f64 = 1.0;
 
-/// The ranking rule the verdict states: an effect that does not improve held-out prediction
-/// at any horizon (gain < [`NO_GAIN_PP`] at 10 steps and in simulation: [`best_gain`]) is
-/// never named ahead of a significant effect that does (≥ [`GAIN_PP`] at its own horizon,
-/// where its statistic is judged), whatever their statistics — a sensor offset its own
-/// channel shows, with nothing to win back in the prediction, becomes a note behind the
-/// effect that does. Behind a sensor offset ([`Role::Output`]: the gyro's, which changes no
-/// physics the model predicts) a material effect that gains [`GAIN_PP`] at any horizon
-/// counts: MARIN's KVLCC2 records against a simulator of the hull, the gyro 0.005 °/s off
-/// the heading's turn (−0.05 / −1.26 pp at 10 steps / in simulation), were named
-/// `gyro-bias` ahead of the hull's damping (+0.75 / +9.90 pp). The first such effect behind the first material one moves ahead of it
+/// The ranking rule the verdict states: an effect that does not improve held-out prediction at
+/// any horizon (gain < [`NO_GAIN_PP`] at 10 steps and in simulation: [`best_gain`]) is never
+/// named ahead of a significant effect that does (≥ [`GAIN_PP`] at its own horizon, where its
+/// statistic is judged), whatever their statistics — a sensor offset its own channel shows,
+/// with nothing to win back in the prediction, becomes a note behind the effect that does.
+/// Behind a sensor offset ([`Role::Output`]: the gyro's, which changes no physics the model
+/// predicts) a material effect that gains [`GAIN_PP`] at any horizon counts: MARIN's KVLCC2
+/// records against a simulator of the hull, the gyro 0.005 °/s off the heading's turn (−0.05 /
+/// −1.26 pp at 10 steps / in simulation), were named `gyro-bias` ahead of the hull's damping
+/// (+0.75 / +9.90 pp). The first such effect behind the first material one moves ahead of it
 /// (`gains[i]`: held-out gain and fits of the significant effects, in the order of `ev`;
 /// `before`: the held-out fits without an effect). Returns the effect passed over, if any.
 ///
