@@ -27,7 +27,7 @@
 #   F  reference: A's simulator logging its gear's angle (`simulate --log-angle`);
 #      trials: the 13 records, angle — the same signal in both
 # Prints per case the verdict, the second effect, the slew limit's p and estimate, and the
-# `command-steps` caveat's figures; DIR/summary.tsv holds the same.
+# `command-steps` and `noise-gain` caveats' figures (`lib.sh`); DIR/summary.tsv holds the same.
 set -euo pipefail
 {
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -44,10 +44,9 @@ while [ $# -gt 0 ]; do
         *) echo "unknown argument $1" >&2; exit 2 ;;
     esac
 done
-if [ -z "$yawcast" ]; then
-    (cd "$repo" && cargo build -q --release -p yawcast)
-    yawcast="${CARGO_TARGET_DIR:-$repo/target}/release/yawcast"
-fi
+# shellcheck source=bench/real/lib.sh
+. "$repo/bench/real/lib.sh"
+yawcast="$(yawcast_binary "$repo" "$yawcast")"
 mkdir -p "$work/ref"
 python3 "$repo/bench/real/kvlcc2_hsva.py" "$src" "$work/angle"
 python3 "$repo/bench/real/kvlcc2_hsva.py" "$src" "$work/command" --command > /dev/null
@@ -83,40 +82,17 @@ rec_ref=(--model "$work/ref/records.postcard")
 for r in "${refs[@]}"; do rec_ref+=(--reference "$work/angle/$r.csv"); done
 all=()
 for f in "$work"/angle/z*.csv; do all+=("$(basename "$f" .csv)"); done
-data() { # data KIND NAME…
-    local kind="$1"; shift
-    for n in "$@"; do printf -- '--data\n%s\n' "$work/$kind/$n.csv"; done
-}
-
-printf 'case\tseed\tverdict\tthen\trate_limit_p\trate_limit_degps\tcommand_steps\n' \
-    > "$work/summary.tsv"
-diag() { # diag CASE SEED ARGS…
-    local case="$1" seed="$2"; shift 2
-    local out="$work/$case-$seed.json"
-    local seedargs=()
-    [ "$seed" = data ] || seedargs=(--seed "$seed")
-    "$yawcast" diagnose "$@" "${seedargs[@]}" --json "$out" > "$work/$case-$seed.txt" 2>&1
-    python3 - "$out" "$case" "$seed" >> "$work/summary.tsv" <<'EOF'
-import json, sys
-d = json.load(open(sys.argv[1]))
-rl = next(r for r in d["ranking"] if r["effect"] == "rate-limit")
-cs = [c for c in d["caveats"] if c["caveat"] == "command-steps"]
-steps = "-" if not cs else "trials {:.1f}, reference {:.2f} deg/sample ({:.1f} deg/s)".format(
-    cs[0]["trial_step_deg"], cs[0]["reference_step_deg"], cs[0]["slew_degps"])
-print("\t".join([sys.argv[2], sys.argv[3], d["verdict"], d["then"] or "-",
-                 "{:.2g}".format(rl["p_value"]), "{:.1f}".format(rl["parameter"]), steps]))
-EOF
-}
-mapfile -t a < <(data angle "${all[@]}")
-mapfile -t c < <(data command "${all[@]}")
-mapfile -t ta < <(data angle "${trials[@]}")
-mapfile -t tc < <(data command "${trials[@]}")
-diag A data "${sim_ref[@]}" "${a[@]}"
-diag B data "${sim_ref[@]}" "${c[@]}"
-diag C data "${rec_ref[@]}" "${ta[@]}"
-diag D data "${rec_ref[@]}" "${tc[@]}"
-for s in $(seq 1 "$seeds"); do diag D "$s" "${rec_ref[@]}" "${tc[@]}"; done
-diag E data --model "$work/ref/records.postcard" "${tc[@]}"
-diag F data "${sim_angle[@]}" "${a[@]}"
+summary_header "$work/summary.tsv"
+mapfile -t a < <(data "$work" angle "${all[@]}")
+mapfile -t c < <(data "$work" command "${all[@]}")
+mapfile -t ta < <(data "$work" angle "${trials[@]}")
+mapfile -t tc < <(data "$work" command "${trials[@]}")
+diag "$work" A data "${sim_ref[@]}" "${a[@]}"
+diag "$work" B data "${sim_ref[@]}" "${c[@]}"
+diag "$work" C data "${rec_ref[@]}" "${ta[@]}"
+diag "$work" D data "${rec_ref[@]}" "${tc[@]}"
+for s in $(seq 1 "$seeds"); do diag "$work" D "$s" "${rec_ref[@]}" "${tc[@]}"; done
+diag "$work" E data --model "$work/ref/records.postcard" "${tc[@]}"
+diag "$work" F data "${sim_angle[@]}" "${a[@]}"
 column -t -s "$(printf '\t')" "$work/summary.tsv"
 }

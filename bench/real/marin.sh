@@ -33,7 +33,7 @@
 #      fine as the trials', the model's Kalman gain no longer carries their noise 1 661
 #      times over into its 10-step prediction (caveat `noise-gain` in G and H)
 # Prints per case the verdict, the second effect, the slew limit's p and estimate, and the
-# `command-steps` and `noise-gain` caveats' figures; DIR/summary.tsv holds the same.
+# `command-steps` and `noise-gain` caveats' figures (`lib.sh`); DIR/summary.tsv holds the same.
 set -euo pipefail
 {
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -48,10 +48,9 @@ while [ $# -gt 0 ]; do
         *) echo "unknown argument $1" >&2; exit 2 ;;
     esac
 done
-if [ -z "$yawcast" ]; then
-    (cd "$repo" && cargo build -q --release -p yawcast)
-    yawcast="${CARGO_TARGET_DIR:-$repo/target}/release/yawcast"
-fi
+# shellcheck source=bench/real/lib.sh
+. "$repo/bench/real/lib.sh"
+yawcast="$(yawcast_binary "$repo" "$yawcast")"
 mkdir -p "$work/ref"
 python3 "$repo/bench/real/kvlcc2_marin.py" "$marin" "$work/angle"
 python3 "$repo/bench/real/kvlcc2_marin.py" "$marin" "$work/command" --command > /dev/null
@@ -94,38 +93,14 @@ for r in "${refs[@]}"; do
     hsva3_ref+=(--reference "$work/hsva3/$r.csv")
 done
 trials=(zz10 zz-10 zz20 zz-20)
-data() { # data KIND NAME…
-    local kind="$1"; shift
-    for n in "$@"; do printf -- '--data\n%s\n' "$work/$kind/$n.csv"; done
-}
-
-printf 'case\tverdict\tthen\trate_limit_p\trate_limit_degps\tcommand_steps\tnoise_gain\n' \
-    > "$work/summary.tsv"
-diag() { # diag CASE ARGS…
-    local case="$1"; shift
-    local out="$work/$case.json"
-    "$yawcast" diagnose "$@" --json "$out" > "$work/$case.txt" 2>&1
-    python3 - "$out" "$case" >> "$work/summary.tsv" <<'PY'
-import json, sys
-d = json.load(open(sys.argv[1]))
-rl = next(r for r in d["ranking"] if r["effect"] == "rate-limit")
-cs = [c for c in d["caveats"] if c["caveat"] == "command-steps"]
-steps = "-" if not cs else "trials {:.1f}, reference {:.2f} deg/sample ({:.1f} deg/s)".format(
-    cs[0]["trial_step_deg"], cs[0]["reference_step_deg"], cs[0]["slew_degps"])
-ng = [c for c in d["caveats"] if c["caveat"] == "noise-gain"]
-noise = "-" if not ng else "{:.0f} x {:.1e} deg/s (reference {:.1e})".format(
-    ng[0]["gain_10"], ng[0]["trials_noise_degps"], ng[0]["reference_noise_degps"])
-print("\t".join([sys.argv[2], d["verdict"], d["then"] or "-",
-                 "{:.2g}".format(rl["p_value"]), "{:.2f}".format(rl["parameter"]), steps, noise]))
-PY
-}
-mapfile -t a < <(data angle "${trials[@]}")
-mapfile -t c < <(data command "${trials[@]}")
-diag A "${sim_ref[@]}" "${a[@]}"
-diag B "${sim_ref[@]}" "${c[@]}"
-diag F "${sim_angle[@]}" "${a[@]}"
-diag G "${hsva_ref[@]}" "${a[@]}"
-diag H "${hsva_ref[@]}" "${c[@]}"
-diag I "${hsva3_ref[@]}" "${a[@]}"
+summary_header "$work/summary.tsv"
+mapfile -t a < <(data "$work" angle "${trials[@]}")
+mapfile -t c < <(data "$work" command "${trials[@]}")
+diag "$work" A data "${sim_ref[@]}" "${a[@]}"
+diag "$work" B data "${sim_ref[@]}" "${c[@]}"
+diag "$work" F data "${sim_angle[@]}" "${a[@]}"
+diag "$work" G data "${hsva_ref[@]}" "${a[@]}"
+diag "$work" H data "${hsva_ref[@]}" "${c[@]}"
+diag "$work" I data "${hsva3_ref[@]}" "${a[@]}"
 column -t -s "$(printf '\t')" "$work/summary.tsv"
 }
