@@ -27,11 +27,12 @@
 #   F  reference: A's simulator logging its gear's angle (`simulate --log-angle`);
 #      trials: the 13 records, angle — the same signal in both
 # Prints per case the verdict, the second effect, the slew limit's p and estimate, and the
-# `command-steps` and `noise-gain` caveats' figures (`lib.sh`); DIR/summary.tsv holds the same.
+# `command-steps`, `noise-gain` and `noisier-trials` caveats' figures (`lib.sh`);
+# DIR/summary.tsv holds the same.
 set -euo pipefail
 {
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
-[ $# -ge 1 ] || { sed -n '2,30p' "$0"; exit 2; }
+[ $# -ge 1 ] || { sed -n '2,31p' "$0"; exit 2; }
 src="$1"; shift
 yawcast=""
 work="$repo/target/bench-hsva"

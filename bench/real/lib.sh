@@ -7,8 +7,8 @@
 #   diag WORK CASE SEED ARGS…  `yawcast diagnose ARGS…` (with `--seed SEED` unless SEED is
 #                              `data`) into WORK/CASE-SEED.{json,txt}, and its line into
 #                              WORK/summary.tsv: the verdict, the second effect, the slew
-#                              limit's p and estimate, the `command-steps` and `noise-gain`
-#                              caveats' figures
+#                              limit's p and estimate, the `command-steps`, `noise-gain` and
+#                              `noisier-trials` caveats' figures
 # The caller sets `yawcast` to the binary before calling `diag`.
 
 yawcast_binary() {
@@ -27,7 +27,7 @@ data() {
 }
 
 summary_header() {
-    printf 'case\tseed\tverdict\tthen\trate_limit_p\trate_limit_degps\tcommand_steps\tnoise_gain\n' \
+    printf 'case\tseed\tverdict\tthen\trate_limit_p\trate_limit_degps\tcommand_steps\tnoise_gain\tnoisier_trials\n' \
         > "$1"
 }
 
@@ -47,8 +47,12 @@ steps = "-" if not cs else "trials {:.1f}, reference {:.2f} deg/sample ({:.1f} d
 ng = [c for c in d["caveats"] if c["caveat"] == "noise-gain"]
 noise = "-" if not ng else "{:.0f} x {:.1e} deg/s (reference {:.1e})".format(
     ng[0]["gain_10"], ng[0]["trials_noise_degps"], ng[0]["reference_noise_degps"])
+nt = [c for c in d["caveats"] if c["caveat"] == "noisier-trials"]
+noisier = "-" if not nt else "{:.1e} against {:.1e} deg/s; gain {:.3g} -> {:.3g}".format(
+    nt[0]["trials_noise_degps"], nt[0]["reference_noise_degps"], nt[0]["gain_10_given"],
+    nt[0]["gain_10"])
 print("\t".join([sys.argv[2], sys.argv[3], d["verdict"], d["then"] or "-",
                  "{:.2g}".format(rl["p_value"]), "{:.2f}".format(rl["parameter"]), steps,
-                 noise]))
+                 noise, noisier]))
 PY
 }

@@ -31,13 +31,16 @@
 #   I  G's reference with its yaw rate written to 3 significant figures, as MARIN's, and
 #      the model identified on it; trials: MARIN's 4, angle — identified on records as
 #      fine as the trials', the model's Kalman gain no longer carries their noise 1 661
-#      times over into its 10-step prediction (caveat `noise-gain` in G and H)
+#      times over into its 10-step prediction (where the trials are noisier than the
+#      reference, diagnose gives the reference their noise and re-fits the gain: caveat
+#      `noisier-trials` in G and H; `noise-gain` where it could not)
 # Prints per case the verdict, the second effect, the slew limit's p and estimate, and the
-# `command-steps` and `noise-gain` caveats' figures (`lib.sh`); DIR/summary.tsv holds the same.
+# `command-steps`, `noise-gain` and `noisier-trials` caveats' figures (`lib.sh`);
+# DIR/summary.tsv holds the same.
 set -euo pipefail
 {
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
-[ $# -ge 2 ] || { sed -n '2,36p' "$0"; exit 2; }
+[ $# -ge 2 ] || { sed -n '2,39p' "$0"; exit 2; }
 marin="$1"; hsva="$2"; shift 2
 yawcast=""
 work="$repo/target/bench-marin"

@@ -5,7 +5,7 @@
 #   bench/worlds/run.sh [--yawcast PATH] [--work DIR] [--worlds LIST] [--seeds N]
 #                       [--strengths LIST] [--effects LIST] [--jobs J] [--log-wind]
 #                       [--augment] [--won-back] [--trial-input KIND] [--ref-input KIND]
-#                       [--ts S] [--noise-scale K] [--duration S]
+#                       [--ts S] [--noise-scale K] [--trial-noise-scale K] [--duration S]
 #                       [--trial-disturbance K] [--ref-disturbance K] [--ref-effect NAME]
 #                       [--ref-log-angle] [--trial-log-angle]
 #
@@ -48,6 +48,9 @@
 #                     faster or slower
 #   --noise-scale K   every sensor's noise (gyro, heading, speed; reference and trials) times
 #                     K (default 1; 3 is a MEMS gyro's 0.09 °/s on the trials)
+#   --trial-noise-scale K  the trials' (and the validation record's) sensors' noise times K
+#                     more (default 1; e.g. 4: a reference from a quiet simulator, trials
+#                     logged on board with a MEMS gyro)
 #   --duration S      the length of every record, reference and trials (`simulate
 #                     --duration`; default 1 800 s)
 #   --trial-disturbance K  the background yaw disturbance of the trials (and the validation
@@ -92,6 +95,7 @@ trialinput=prbs
 refinput=prbs
 ts=""
 noisescale=1
+trialnoisescale=1
 duration=""
 trialdist=""
 refdist=""
@@ -115,6 +119,7 @@ while [ $# -gt 0 ]; do
         --ref-input) refinput="$2"; shift 2 ;;
         --ts) ts="--ts $2"; shift 2 ;;
         --noise-scale) noisescale="$2"; shift 2 ;;
+        --trial-noise-scale) trialnoisescale="$2"; shift 2 ;;
         --duration) duration="--duration $2"; shift 2 ;;
         --trial-disturbance) trialdist="--disturbance $2"; shift 2 ;;
         --ref-disturbance) refdist="--disturbance $2"; shift 2 ;;
@@ -122,7 +127,7 @@ while [ $# -gt 0 ]; do
         --ref-design-speed) refdesign=1; shift ;;
         --ref-log-angle) refangle="--log-angle"; shift ;;
         --trial-log-angle) trialangle="--log-angle"; shift ;;
-        -h|--help) sed -n '2,73p' "$0"; exit 0 ;;
+        -h|--help) sed -n '2,76p' "$0"; exit 0 ;;
         *) echo "unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
@@ -134,8 +139,9 @@ mkdir -p "$work"
 export YAWCAST="$yawcast" WORK="$work" LOGWIND="$logwind" AUGMENT="$augment" WONBACK="$wonback"
 export TRIALINPUT="$trialinput" TSARG="$ts $duration"
 # the sensors' noise: the trials' (and the validation record's), the reference's
-scaled() { awk -v a="$1" -v k="$noisescale" 'BEGIN { print a * k }'; }
-export TRIALNOISE="--gyro-noise $(scaled 0.03) --heading-noise $(scaled 0.2) --speed-noise $(scaled 0.02) $trialdist $trialangle"
+scaled() { awk -v a="$1" -v k="$noisescale" -v t="${2:-1}" 'BEGIN { print a * k * t }'; }
+tk="$trialnoisescale"
+export TRIALNOISE="--gyro-noise $(scaled 0.03 "$tk") --heading-noise $(scaled 0.2 "$tk") --speed-noise $(scaled 0.02 "$tk") $trialdist $trialangle"
 refnoise=(--gyro-noise "$(scaled 0.02)" --heading-noise "$(scaled 0.1)" $refdist $refeffect $refangle)
 
 # a world's `simulate` arguments, one a line: NAME, NAME@L for the world scaled to L m,
@@ -282,7 +288,7 @@ xargs -P "$jobs" -L 1 bash -c 'case_run "$@"' _ <"$list" | sort >"$work/cases.ts
 secs=$(( $(date +%s) - start ))
 
 python3 - "$work/cases.tsv" "$secs" "$(nproc)" "$trialinput" "$refinput" "${ts#--ts }" \
-    "$noisescale" "${duration#--duration }" <<'EOF'
+    "$noisescale" "${duration#--duration }" "$trialnoisescale" <<'EOF'
 import collections, sys
 allrows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
 rows = [r for r in allrows if "+" not in r[2]]
@@ -303,6 +309,8 @@ if ts:
     print(f"Every record logged at Ts = {ts} s.\n")
 if sys.argv[7] != "1":
     print(f"Every sensor's noise times {sys.argv[7]}.\n")
+if sys.argv[9] != "1":
+    print(f"The trials' sensors' noise times {sys.argv[9]} more than the reference's.\n")
 if sys.argv[8]:
     print(f"Every record {sys.argv[8]} s long.\n")
 if pairs:

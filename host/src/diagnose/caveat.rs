@@ -188,6 +188,21 @@ pub enum Caveat {
         /// The white noise on the reference's yaw rate (°/s).
         reference_noise_degps: f64,
     },
+    /// The trials' yaw rate is noisier than the reference's (twice or more): the reference
+    /// records were given the difference as white noise and the model's Kalman gain
+    /// re-fitted on them (`noise.rs`); the statistics are measured against those.
+    NoisierTrials {
+        /// The white noise on the trials' yaw rate, from its fourth differences (°/s).
+        trials_noise_degps: f64,
+        /// On the reference's as given (°/s).
+        reference_noise_degps: f64,
+        /// The white noise added to the reference's yaw rate (°/s).
+        added_noise_degps: f64,
+        /// The model given's noise gain at 10 steps ([`crate::identify::predict::noise_gain`]).
+        gain_10_given: f64,
+        /// The re-fitted model's.
+        gain_10: f64,
+    },
     /// The trials ran at another speed than the reference, by [`OTHER_SPEED`] or more of
     /// the reference's: a hull's rudder gain and time constants change with speed through
     /// the water, which the library's effects can only mimic. Either the difference exceeds
@@ -566,6 +581,7 @@ impl Caveat {
                 slew_degps,
             } => super::commands::steps_words(*trial_step_deg, *reference_step_deg, *slew_degps),
             Caveat::NoiseGain { .. } => super::noise::words(self),
+            Caveat::NoisierTrials { .. } => super::noise::matched_words(self),
             Caveat::OtherManoeuvre { distance, hull } => {
                 let nulls = if hull.is_empty() {
                     "The reference records show no hull physics of their own that the null \

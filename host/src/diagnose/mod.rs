@@ -362,6 +362,13 @@ pub fn diagnose(
     cfg: &DiagnoseConfig,
 ) -> Result<Diagnosis, DiagnoseError> {
     check(model, reference, est, val, cfg)?;
+    // trials noisier than the reference: measured against the reference given their noise
+    if let Some(m) = noise::matched_reference(model, reference, est, cfg) {
+        let mut d = run(&m.model, &m.reference, est, val, cfg, Against::Given)?;
+        caveat::append_words(&mut d.explanation, std::slice::from_ref(&m.caveat));
+        d.caveats.push(m.caveat);
+        return Ok(d);
+    }
     run(model, reference, est, val, cfg, Against::Given)
 }
 

@@ -1,10 +1,16 @@
-//! The model's gain on measurement noise against the trials' own noise: the caveat
-//! [`Caveat::NoiseGain`] where the trials' noise, carried by a Kalman gain fitted to smoother
-//! records, is what their 10-step errors are.
+//! The model's gain on measurement noise against the trials' own noise: where the trials'
+//! yaw rate is noisier than the reference's, the reference is given the difference and the
+//! model's Kalman gain re-fitted on it ([`matched_reference`], [`Caveat::NoisierTrials`]);
+//! the caveat [`Caveat::NoiseGain`] where the trials' noise, carried by a Kalman gain fitted
+//! to smoother records, is still what their 10-step errors are.
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
 
 use super::caveat::Caveat;
 use super::evidence::Set;
-use crate::identify::{model::Model, predict};
+use super::DiagnoseConfig;
+use crate::identify::{model::Model, pem, predict};
 use crate::io::data::Record;
 
 /// The horizon whose noise gain is read: the 10 steps the ranking rule compares.
@@ -21,6 +27,82 @@ const AMPLIFIES: f64 = predict::NOISE_AMPLIFIES;
 /// The trials' noise, for their yaw rate's spread, this many times the reference's or more:
 /// noisier records than the gain was fitted to.
 const NOISIER: f64 = 10.0;
+
+/// The trials' white noise on the yaw rate this many times the reference's or more: the
+/// reference is given the difference ([`matched_reference`]). Sensors alike read alike: the
+/// test worlds' trials (a gyro of 0.03 °/s against the reference's 0.02) read 1.28–1.53
+/// times the reference's, and nothing changes for them.
+const MATCH_FROM: f64 = 2.0;
+
+/// Iterations of the Kalman gain's re-fit (4 numbers, from the model's own).
+const REFIT_ITER: usize = 50;
+
+/// The reference records given white noise on their yaw rate to the trials' level, and the
+/// model with its Kalman gain re-fitted on them ([`pem::refit_gain`]; A, B and the effects
+/// kept), where the trials' noise is [`MATCH_FROM`] times the reference's or more.
+pub(super) struct Matched {
+    /// The model the method measures the trials against.
+    pub model: Model,
+    /// The reference records with the added noise.
+    pub reference: Vec<Record>,
+    /// [`Caveat::NoisierTrials`].
+    pub caveat: Caveat,
+}
+
+/// [`Matched`] for `trials` against `reference`, or `None` where the trials are not
+/// [`MATCH_FROM`] times noisier (or there is no reference, or the re-fit fails: the method
+/// then runs against the reference as given, and [`noise_gain`] says what that means).
+///
+/// Why: a Kalman gain fitted to quiet records trusts each measurement; on noisier trials
+/// it carries their noise into every prediction, and the nulls, simulated with the
+/// reference's innovations, are narrower than the trials' own scatter. A gyro on board
+/// noisier than a simulator's or a tank's is the rule, not the exception. The noise is
+/// drawn from `cfg.seed`, so the same records give the same diagnosis.
+pub(super) fn matched_reference(
+    model: &Model,
+    reference: &[Record],
+    trials: &[Record],
+    cfg: &DiagnoseConfig,
+) -> Option<Matched> {
+    if reference.is_empty() || trials.is_empty() {
+        return None;
+    }
+    let (noise, _) = noise_and_spread(trials);
+    let (r_noise, _) = noise_and_spread(reference);
+    if !(noise.is_finite() && noise >= MATCH_FROM * r_noise) {
+        return None;
+    }
+    let added = (noise * noise - r_noise * r_noise).sqrt();
+    let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed ^ 0x4e4f_4953_4552);
+    let noisy: Vec<Record> = reference
+        .iter()
+        .map(|r| {
+            let mut r = r.clone();
+            for v in r.y.iter_mut().filter(|v| v.is_finite()) {
+                *v += added * crate::stats::standard_normal(&mut rng);
+            }
+            r
+        })
+        .collect();
+    let pcfg = pem::PemConfig {
+        max_iter: REFIT_ITER,
+        parallel: cfg.parallel,
+        ..Default::default()
+    };
+    let refit = pem::refit_gain(&noisy, model, &pcfg).ok()?;
+    let caveat = Caveat::NoisierTrials {
+        trials_noise_degps: noise,
+        reference_noise_degps: r_noise,
+        added_noise_degps: added,
+        gain_10_given: predict::noise_gain(model, HORIZON),
+        gain_10: predict::noise_gain(&refit, HORIZON),
+    };
+    Some(Matched {
+        model: refit,
+        reference: noisy,
+        caveat,
+    })
+}
 
 /// The white noise on records' yaw rate, from its fourth differences (`Var Δ⁴y = 70σ²` for
 /// white noise; a ship's yaw rate is too smooth between samples to add to them: HSVA's
@@ -71,6 +153,31 @@ pub(super) fn noise_gain(model: &Model, trials: &[Record], reference: &[Record])
         trials_ten_step_degps: ten,
         reference_noise_degps: r_noise,
     })
+}
+
+/// [`Caveat::NoisierTrials`]'s words (empty for another caveat).
+pub(super) fn matched_words(c: &Caveat) -> String {
+    let &Caveat::NoisierTrials {
+        trials_noise_degps: noise,
+        reference_noise_degps: reference,
+        added_noise_degps: added,
+        gain_10_given: given,
+        gain_10: gain,
+    } = c
+    else {
+        return String::new();
+    };
+    format!(
+        "The trials' yaw rate carries white noise of about {noise:.2e} °/s (from its fourth \
+         differences), {:.1} times the reference's {reference:.2e} °/s: a Kalman gain fitted \
+         to the quieter records trusts each measurement more than the trials deserve. So the \
+         reference records were given white noise of {added:.2e} °/s more (seeded) and the \
+         model's Kalman gain re-fitted on them, A and B kept (its {HORIZON}-step prediction \
+         carries white noise on the yaw rate {given:.2} times over as given, {gain:.2} times \
+         re-fitted); every statistic and null is measured against that model and those \
+         records.",
+        noise / reference.max(f64::MIN_POSITIVE)
+    )
 }
 
 /// [`Caveat::NoiseGain`]'s words (empty for another caveat).
@@ -177,5 +284,73 @@ mod tests {
         // to), nor without a reference
         assert_eq!(noise_gain(&smooth, &trials, &trials[..1]), None);
         assert_eq!(noise_gain(&smooth, &trials, &[]), None);
+    }
+
+    #[test]
+    fn trials_noisier_than_the_reference_are_measured_against_a_reference_as_noisy() {
+        // a slow hull; the reference's yaw rate carries 0.005 °/s of white noise, the
+        // trials' 0.03 °/s (a simulator's records against a ship's gyro)
+        let m = Model::new(
+            1.0,
+            vec![-0.99 * 0.999, 0.99 + 0.999],
+            vec![0.0, 0.0001],
+            vec![0.5, 0.5],
+        )
+        .unwrap();
+        let trials: Vec<Record> = (0..2).map(|s| record(&m, 0.03, s)).collect();
+        let reference: Vec<Record> = (2..4).map(|s| record(&m, 0.005, s)).collect();
+        let cfg = DiagnoseConfig {
+            parallel: false,
+            ..DiagnoseConfig::default()
+        };
+        let got = matched_reference(&m, &reference, &trials, &cfg).expect("matched");
+        let Caveat::NoisierTrials {
+            trials_noise_degps: noise,
+            reference_noise_degps: r,
+            added_noise_degps: added,
+            gain_10_given,
+            gain_10,
+        } = got.caveat
+        else {
+            panic!("{:?}", got.caveat);
+        };
+        assert!(
+            (noise - 0.03).abs() < 1.5e-3 && (r - 0.005).abs() < 5e-4,
+            "{noise} {r}"
+        );
+        assert!((added * added + r * r - noise * noise).abs() < 1e-12);
+        // the reference now reads the trials' noise, and only its yaw rate changed
+        let (now, _) = noise_and_spread(&got.reference);
+        assert!((now - noise).abs() < 0.05 * noise, "{now} {noise}");
+        for (a, b) in got.reference.iter().zip(&reference) {
+            assert_eq!(a.u, b.u);
+            assert_ne!(a.y, b.y);
+        }
+        // A and B kept, the gain re-fitted: it trusts each measurement less
+        assert_eq!((&got.model.a, &got.model.b), (&m.a, &m.b));
+        assert_ne!(got.model.k, m.k);
+        assert!(gain_10 < gain_10_given, "{gain_10} {gain_10_given}");
+        assert_eq!(gain_10_given, predict::noise_gain(&m, HORIZON));
+        let words = got.caveat.explain();
+        assert!(words.contains("6.1 times the reference's"), "{words}");
+        let v = serde_json::to_value(&got.caveat).unwrap();
+        assert_eq!(v["caveat"], "noisier-trials");
+        for key in [
+            "trials_noise_degps",
+            "reference_noise_degps",
+            "added_noise_degps",
+            "gain_10_given",
+            "gain_10",
+        ] {
+            assert!(v[key].as_f64().is_some_and(f64::is_finite), "{key}: {v}");
+        }
+        // the same seed, the same noise; trials as noisy as the reference (or 1.5 times,
+        // the test worlds' gyros), or no reference: nothing changes
+        let again = matched_reference(&m, &reference, &trials, &cfg).unwrap();
+        assert_eq!(again.reference[0].y, got.reference[0].y);
+        let alike: Vec<Record> = (4..6).map(|s| record(&m, 0.0075, s)).collect();
+        assert!(matched_reference(&m, &reference, &alike, &cfg).is_none());
+        assert!(matched_reference(&m, &reference, &reference, &cfg).is_none());
+        assert!(matched_reference(&m, &[], &trials, &cfg).is_none());
     }
 }

@@ -806,3 +806,72 @@ fn a_tanker_of_a_third_family_reads_its_effects_and_says_what_wind_it_cannot_see
         );
     }
 }
+
+#[test]
+fn trials_logged_with_noisier_sensors_are_measured_against_a_reference_as_noisy() {
+    // Mariner's reference sailed as the suite sails it (gyro 0.02 °/s, heading 0.1°), the
+    // trials logged with sensors 4 times noisier (a ship's MEMS gyro against a quiet rig;
+    // `run.sh --trial-noise-scale 4`, seed 1). Against the reference as given the
+    // effect-free trials read `nonlinear-damping`, the trials' noise carried through a
+    // Kalman gain fitted to quieter records; against the reference given the trials' noise
+    // and the gain re-fitted on it, `none`, and a hidden dead time is still named
+    use crate::sim::WorldKind;
+    let k = WorldKind::Mariner;
+    let w = crate::sim::World::new(k, None).unwrap();
+    let sail = |noise: [f64; 3], effects: Vec<SimEffect>, seeds: &[u64]| {
+        let sc = Scenario {
+            n_samples: 1800,
+            input: w.default_input(),
+            noise: NoiseSpec {
+                gyro_std_degps: noise[0],
+                heading_std_deg: noise[1],
+                speed_std_mps: noise[2],
+            },
+            effects,
+            ..Scenario::default()
+        };
+        w.simulate_many(&sc, seeds).unwrap()
+    };
+    let reference = sail([0.02, 0.1, 0.02], Vec::new(), &[900, 901, 902]);
+    let model = identify(&reference);
+    let cfg = DiagnoseConfig {
+        seed: 1,
+        ..DiagnoseConfig::default()
+    };
+    for (hidden, named) in [(None, "none"), (Some(EffectKind::DeadTime), "dead-time")] {
+        let effects = hidden.map(|e| vec![w.hidden(e, 1.0)]).unwrap_or_default();
+        let trials = sail([0.12, 0.8, 0.08], effects, &[101, 102, 103]);
+        let d = diagnose(&model, &reference, &trials, &[], &cfg).unwrap();
+        let matched = d.caveats.iter().find_map(|c| match c {
+            Caveat::NoisierTrials {
+                trials_noise_degps,
+                reference_noise_degps,
+                gain_10_given,
+                gain_10,
+                ..
+            } => Some([
+                *trials_noise_degps,
+                *reference_noise_degps,
+                *gain_10_given,
+                *gain_10,
+            ]),
+            _ => None,
+        });
+        println!("{hidden:?}: {} ({:?}); {matched:?}", d.verdict, d.then);
+        assert_eq!(d.verdict, named, "{}", d.explanation);
+        let [noise, r, given, gain] = matched.expect("noisier-trials caveat");
+        // the gyros' 0.12 and 0.02 °/s (the hull's own motion adds a little to both)
+        assert!(
+            (noise - 0.12).abs() < 0.012 && (r - 0.02).abs() < 0.004,
+            "{noise} {r}"
+        );
+        assert!(gain < given, "{gain} {given}");
+        assert!(d.explanation.contains("Kalman gain re-fitted on them"));
+        if hidden.is_none() {
+            // the method against the reference as given: a false alarm
+            let given = run(&model, &reference, &trials, &[], &cfg, Against::Given).unwrap();
+            println!("as given: {} ({:?})", given.verdict, given.then);
+            assert_eq!(given.verdict, "nonlinear-damping", "{}", given.explanation);
+        }
+    }
+}

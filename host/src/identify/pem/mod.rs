@@ -286,6 +286,74 @@ pub fn identify_from(
     )
 }
 
+/// `model` with its Kalman gain K re-fitted on `records`, A, B and the effects' gains kept:
+/// the predictor of the same ship for records whose sensors are noisier (or quieter) than
+/// those it was identified on. A gain fitted to smooth records passes their last
+/// measurements on; on noisier ones the best gain trusts them less.
+///
+/// A, B and the gains are held by a penalty 10¹⁰ times the records' energy (far above the
+/// cost's own curvature), and restored exactly afterwards: only K comes from the search
+/// (`cfg.max_iter`, `cfg.tol`, `cfg.parallel`).
+///
+/// # Errors
+/// As [`identify_from`]; [`IdentError::Unstable`] when the predictor with the re-fitted gain
+/// is not stable.
+///
+/// ```
+/// use rand::SeedableRng;
+/// use yawcast::{io::data::Record, identify::model::Model, identify::pem, identify::predict};
+/// let m = Model::new(1.0, vec![-0.3, 0.9], vec![0.5, 0.4], vec![0.2, 0.1]).unwrap();
+/// let u: Vec<f64> = (0..600).map(|i| if (i * 37 / 11) % 2 == 0 { 1.0 } else { -1.0 }).collect();
+/// let mut rec = Record::from_uy("sim", 1.0, u, vec![0.0; 600]);
+/// // the ship without process noise, its yaw rate measured with white noise: the best
+/// // predictor is the simulation, K = 0
+/// let clean = Model { k: vec![0.0, 0.0], ..m.clone() };
+/// let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+/// rec.y = predict::simulate(&clean, &rec, &[0.0, 0.0])
+///     .into_iter()
+///     .map(|y| y + 0.1 * yawcast::stats::standard_normal(&mut rng))
+///     .collect();
+/// let refit = pem::refit_gain(&[rec], &m, &pem::PemConfig::default()).unwrap();
+/// assert_eq!((refit.a.clone(), refit.b.clone()), (m.a.clone(), m.b.clone()));
+/// assert!(refit.k.iter().all(|k| k.abs() < 0.05), "{:?}", refit.k);
+/// ```
+pub fn refit_gain(records: &[Record], model: &Model, cfg: &PemConfig) -> Result<Model, IdentError> {
+    let n = model.n;
+    let nominal = params_of(model);
+    let energy: f64 = records
+        .iter()
+        .flat_map(|r| r.y.iter())
+        .filter(|v| v.is_finite())
+        .map(|v| v * v)
+        .sum();
+    let hold = 1e10 * energy.max(f64::MIN_POSITIVE);
+    let r = (0..nominal.len())
+        .map(|i| {
+            if (2 * n..3 * n).contains(&i) {
+                0.0
+            } else {
+                hold
+            }
+        })
+        .collect();
+    let cfg = PemConfig {
+        lambda: 1.0,
+        r: Some(r),
+        nominal: Some(nominal),
+        ..cfg.clone()
+    };
+    let rep = identify_from(records, model, &cfg)?;
+    let out = Model {
+        k: rep.model.k,
+        ..model.clone()
+    };
+    if out.is_stable() {
+        Ok(out)
+    } else {
+        Err(IdentError::Unstable)
+    }
+}
+
 /// The report of the minimum `s`; AIC and BIC from `ml_sse`, the lowest Σε² any start
 /// reached (= `s.pt.sse` unless a minimum other than the lowest was chosen).
 fn report(
