@@ -347,6 +347,30 @@ pub(super) fn carry_evidence(est: &[Record], reference: &[Record]) -> Option<Car
     })
 }
 
+/// The speeds straight ahead `[trials, reference]` that [`super::caveat::other_speed`]
+/// compares as through the water, and the smallest current (m/s) the ground track shows,
+/// which tells their difference from a current. On records that each hold one course with a current read
+/// across their courses (`carry`, [`super::channels::Channels::across_carry`]): each set's
+/// speed on its courses (`course`) less that current's component along the trials' courses
+/// (the reference's own current is [`super::Caveat::ReferenceEnvironment`]'s), and the current's
+/// resolution at `level`. Else the heading harmonics' straight speeds (`speeds`) and their
+/// `resolution` (none given: no current can be told).
+pub(super) fn through_water(
+    carry: Option<&CarryEvidence>,
+    course: Option<[f64; 2]>,
+    speeds: Option<[f64; 2]>,
+    resolution: Option<f64>,
+    level: f64,
+) -> (Option<[f64; 2]>, f64) {
+    match carry {
+        Some(c) => (
+            course.map(|[t, r]| [t - c.along_courses(), r]),
+            c.smallest(level),
+        ),
+        None => (speeds, resolution.unwrap_or(f64::INFINITY)),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -462,7 +486,7 @@ mod tests {
 
     #[test]
     fn another_speed_is_told_from_a_current_along_the_courses_read_across_them() {
-        use crate::diagnose::caveat::{other_speed, through_water, Caveat};
+        use crate::diagnose::caveat::{other_speed, Caveat};
         let reference = calm_reference();
         let courses = [60.0, 85.0, 110.0];
         let trials = |speed: f64, current: [f64; 2]| -> Vec<Record> {

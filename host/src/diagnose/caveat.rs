@@ -3,7 +3,6 @@
 use serde::Serialize;
 use yawcast_shared::model::EffectKind;
 
-use super::carry::CarryEvidence;
 use super::channels::Channels;
 use super::rule::{GAIN_PP, NO_GAIN_PP};
 use super::verdict::{effect_phrase, fmt_p, Evidence, Moment};
@@ -698,30 +697,6 @@ pub(super) fn caveats(
 /// two differ by at most 5.7 %; the built-in ship's trials sailed with the propeller turning
 /// 8.0 instead of 10.5 rev/s, by 24 %.
 pub const OTHER_SPEED: f64 = 0.15;
-
-/// The speeds straight ahead `[trials, reference]` that [`other_speed`] compares as through
-/// the water, and the smallest current (m/s) the ground track shows, which tells their
-/// difference from a current. On records that each hold one course with a current read
-/// across their courses (`carry`, [`super::channels::Channels::across_carry`]): each set's
-/// speed on its courses (`course`) less that current's component along the trials' courses
-/// (the reference's own current is [`Caveat::ReferenceEnvironment`]'s), and the current's
-/// resolution at `level`. Else the heading harmonics' straight speeds (`speeds`) and their
-/// `resolution` (none given: no current can be told).
-pub(super) fn through_water(
-    carry: Option<&CarryEvidence>,
-    course: Option<[f64; 2]>,
-    speeds: Option<[f64; 2]>,
-    resolution: Option<f64>,
-    level: f64,
-) -> (Option<[f64; 2]>, f64) {
-    match carry {
-        Some(c) => (
-            course.map(|[t, r]| [t - c.along_courses(), r]),
-            c.smallest(level),
-        ),
-        None => (speeds, resolution.unwrap_or(f64::INFINITY)),
-    }
-}
 
 /// [`Caveat::OtherSpeed`] for the speeds `[trials, reference]` when they differ by
 /// [`OTHER_SPEED`] or more: through the water (`speeds`, [`super::channels::straight_speed`])

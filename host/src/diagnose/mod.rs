@@ -636,7 +636,7 @@ fn run(
     // speed through the water: told apart from a current only as far as the ground track
     // resolves one; on records that each hold one course, the speed on their courses less
     // the current read across them, which resolves it there
-    let (speeds, resolution) = caveat::through_water(
+    let (speeds, resolution) = carry::through_water(
         ch.across_carry().as_ref(),
         ch.course_speeds,
         ch.speeds,
