@@ -1,7 +1,7 @@
 //! Criterion benchmarks of the simulator (one 1 800-sample record), `diagnose` on 3 + 3
 //! records of 1 800 samples (with and without the confirming refit) and on 3 600 samples
-//! (one reference and one trial record, the CLI's smallest honest use), and `augment` with a
-//! dead time.
+//! (one reference and one trial record, the CLI's smallest honest use; again with the trial
+//! logged by a noisier gyro), and `augment` with a dead time.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use yawcast::diagnose::augment::{self, AugmentConfig};
@@ -53,6 +53,19 @@ fn bench(c: &mut Criterion) {
     // 3 600 samples in all: one reference record, one trial record (its last 30 % held out)
     g.bench_function("ref1_trial1_3600_samples", |b| {
         b.iter(|| diagnose::diagnose(&model, &reference[..1], &est[..1], &[], &cfg).unwrap())
+    });
+    // the same, the trial logged with a gyro 4 times noisier than the reference's: the
+    // reference given the trial's noise and the Kalman gain re-fitted on it first
+    let noisy = Scenario {
+        noise: NoiseSpec {
+            gyro_std_degps: 0.12,
+            ..trial.noise
+        },
+        ..trial.clone()
+    };
+    let noisy = sim::simulate_many(&ship, &noisy, &[11]).unwrap();
+    g.bench_function("ref1_trial1_3600_samples_noisier_trial", |b| {
+        b.iter(|| diagnose::diagnose(&model, &reference[..1], &noisy, &[], &cfg).unwrap())
     });
     g.bench_function("augment_dead_time_trials3_N1800", |b| {
         b.iter(|| {
