@@ -10,6 +10,7 @@ use rand_chacha::ChaCha8Rng;
 use super::caveat::Caveat;
 use super::evidence::Set;
 use super::DiagnoseConfig;
+use crate::diagnose::augment::sig;
 use crate::identify::{model::Model, pem, predict};
 use crate::io::data::Record;
 
@@ -173,10 +174,11 @@ pub(super) fn matched_words(c: &Caveat) -> String {
          to the quieter records trusts each measurement more than the trials deserve. So the \
          reference records were given white noise of {added:.2e} °/s more (seeded) and the \
          model's Kalman gain re-fitted on them, A and B kept (its {HORIZON}-step prediction \
-         carries white noise on the yaw rate {given:.2} times over as given, {gain:.2} times \
-         re-fitted); every statistic and null is measured against that model and those \
-         records.",
-        noise / reference.max(f64::MIN_POSITIVE)
+         carries white noise on the yaw rate {} times over as given, {} times re-fitted); \
+         every statistic and null is measured against that model and those records.",
+        noise / reference.max(f64::MIN_POSITIVE),
+        sig(given),
+        sig(gain)
     )
 }
 
