@@ -347,12 +347,12 @@ pub(super) fn carry_evidence(est: &[Record], reference: &[Record]) -> Option<Car
     })
 }
 
-/// The speeds straight ahead `[trials, reference]` that [`super::caveat::other_speed`]
-/// compares as through the water, and the smallest current (m/s) the ground track shows,
-/// which tells their difference from a current. On records that each hold one course with a current read
+/// The speeds straight ahead `[trials, reference]` that [`super::caveat::other_speed`] compares
+/// as through the water, and the smallest current (m/s) the ground track shows, which tells
+/// their difference from a current. On records that each hold one course with a current read
 /// across their courses (`carry`, [`super::channels::Channels::across_carry`]): each set's
-/// speed on its courses (`course`) less that current's component along the trials' courses
-/// (the reference's own current is [`super::Caveat::ReferenceEnvironment`]'s), and the current's
+/// speed on its courses (`course`) less that current's component along the trials' courses (the
+/// reference's own current is [`super::Caveat::ReferenceEnvironment`]'s), and the current's
 /// resolution at `level`. Else the heading harmonics' straight speeds (`speeds`) and their
 /// `resolution` (none given: no current can be told).
 pub(super) fn through_water(
