@@ -27,8 +27,8 @@
 #   F  reference: A's simulator logging its gear's angle (`simulate --log-angle`);
 #      trials: the 13 records, angle — the same signal in both
 # Prints per case the verdict, the second effect, the slew limit's p and estimate, and the
-# `command-steps`, `noise-gain` and `noisier-trials` caveats' figures (`lib.sh`);
-# DIR/summary.tsv holds the same.
+# `command-steps`, `noise-gain`, `noisier-trials` and `quieter-trials` caveats' figures
+# (`lib.sh`); DIR/summary.tsv holds the same.
 set -euo pipefail
 {
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"

@@ -7,8 +7,8 @@
 #   diag WORK CASE SEED ARGS…  `yawcast diagnose ARGS…` (with `--seed SEED` unless SEED is
 #                              `data`) into WORK/CASE-SEED.{json,txt}, and its line into
 #                              WORK/summary.tsv: the verdict, the second effect, the slew
-#                              limit's p and estimate, the `command-steps`, `noise-gain` and
-#                              `noisier-trials` caveats' figures
+#                              limit's p and estimate, the `command-steps`, `noise-gain`,
+#                              `noisier-trials` and `quieter-trials` caveats' figures
 # The caller sets `yawcast` to the binary before calling `diag`.
 
 yawcast_binary() {
@@ -27,7 +27,7 @@ data() {
 }
 
 summary_header() {
-    printf 'case\tseed\tverdict\tthen\trate_limit_p\trate_limit_degps\tcommand_steps\tnoise_gain\tnoisier_trials\n' \
+    printf 'case\tseed\tverdict\tthen\trate_limit_p\trate_limit_degps\tcommand_steps\tnoise_gain\tnoisier_trials\tquieter_trials\n' \
         > "$1"
 }
 
@@ -51,8 +51,11 @@ nt = [c for c in d["caveats"] if c["caveat"] == "noisier-trials"]
 noisier = "-" if not nt else "{:.1e} against {:.1e} deg/s; gain {:.3g} -> {:.3g}".format(
     nt[0]["trials_noise_degps"], nt[0]["reference_noise_degps"], nt[0]["gain_10_given"],
     nt[0]["gain_10"])
+qt = [c for c in d["caveats"] if c["caveat"] == "quieter-trials"]
+quieter = "-" if not qt else "{:.1e} against {:.1e} deg/s; {:.1e} added".format(
+    qt[0]["trials_noise_degps"], qt[0]["reference_noise_degps"], qt[0]["added_noise_degps"])
 print("\t".join([sys.argv[2], sys.argv[3], d["verdict"], d["then"] or "-",
                  "{:.2g}".format(rl["p_value"]), "{:.2f}".format(rl["parameter"]), steps,
-                 noise, noisier]))
+                 noise, noisier, quieter]))
 PY
 }

@@ -35,8 +35,8 @@
 #      reference, diagnose gives the reference their noise and re-fits the gain: caveat
 #      `noisier-trials` in G and H; `noise-gain` where it could not)
 # Prints per case the verdict, the second effect, the slew limit's p and estimate, and the
-# `command-steps`, `noise-gain` and `noisier-trials` caveats' figures (`lib.sh`);
-# DIR/summary.tsv holds the same.
+# `command-steps`, `noise-gain`, `noisier-trials` and `quieter-trials` caveats' figures
+# (`lib.sh`); DIR/summary.tsv holds the same.
 set -euo pipefail
 {
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"

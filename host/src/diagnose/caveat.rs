@@ -202,6 +202,16 @@ pub enum Caveat {
         /// The re-fitted model's.
         gain_10: f64,
     },
+    /// The reference's yaw rate is noisier than the trials' (twice or more): the trials were
+    /// given the difference as white noise for the statistics (`noise.rs`).
+    QuieterTrials {
+        /// The white noise on the trials' yaw rate as logged, from its fourth differences (°/s).
+        trials_noise_degps: f64,
+        /// On the reference's (°/s).
+        reference_noise_degps: f64,
+        /// The white noise added to the trials' yaw rate (°/s).
+        added_noise_degps: f64,
+    },
     /// The trials ran at another speed than the reference, by [`OTHER_SPEED`] or more of
     /// the reference's: a hull's rudder gain and time constants change with speed through
     /// the water, which the library's effects can only mimic. Either the difference exceeds
@@ -581,6 +591,7 @@ impl Caveat {
             } => super::commands::steps_words(*trial_step_deg, *reference_step_deg, *slew_degps),
             Caveat::NoiseGain { .. } => super::noise::words(self),
             Caveat::NoisierTrials { .. } => super::noise::matched_words(self),
+            Caveat::QuieterTrials { .. } => super::noise::quieted_words(self),
             Caveat::OtherManoeuvre { distance, hull } => {
                 let nulls = if hull.is_empty() {
                     "The reference records show no hull physics of their own that the null \
@@ -783,24 +794,6 @@ pub(super) fn reference_environment(ch: &Channels, level: f64) -> Option<Caveat>
     })
 }
 
-/// The caveat for a steady moment named (`named`: the verdict's effect and its second) on
-/// trials whose [`super::separation::heading_separation`] (`separation`) is under
-/// [`super::separation::MIN_HEADING_SEPARATION`], with no anemometer logged
-/// ([`Caveat::BiasOrWind`]): the counterpart of [`Caveat::CurrentOrWind`] for the yaw
-/// channel. Where the anemometer is logged it measures the wind itself.
-pub(super) fn bias_or_wind(
-    named: &[EffectKind],
-    separation: Option<f64>,
-    anemometer: bool,
-    across: Option<[f64; 2]>,
-) -> Option<Caveat> {
-    let s = separation.filter(|&s| s < super::separation::MIN_HEADING_SEPARATION)?;
-    (!anemometer && named.contains(&EffectKind::Bias)).then_some(Caveat::BiasOrWind {
-        separation: s,
-        across,
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -809,44 +802,6 @@ mod tests {
         (0..k)
             .map(|i| Record::from_uy(&format!("r{i}"), ts, vec![0.0; n], vec![0.0; n]))
             .collect()
-    }
-
-    #[test]
-    fn a_steady_moment_on_one_course_without_an_anemometer_may_be_a_wind() {
-        let bias = [EffectKind::RateLimit, EffectKind::Bias];
-        // an autopilot's or a zig-zag's one course, no anemometer: the caveat
-        let c = bias_or_wind(&bias, Some(0.0007), false, None).unwrap();
-        assert_eq!(
-            c,
-            Caveat::BiasOrWind {
-                separation: 0.0007,
-                across: None
-            }
-        );
-        assert!(
-            c.explain().contains("keep 0.07 % of their variance"),
-            "{}",
-            c.explain()
-        );
-        let json = serde_json::to_value(&c).unwrap();
-        assert_eq!(json["caveat"], "bias-or-wind");
-        assert_eq!(json["separation"], 0.0007);
-        assert!(json.get("across").is_none(), "{json}");
-        // the records' courses compared: how far apart, and that no change showed
-        let c = bias_or_wind(&bias, Some(0.0007), false, Some([46.0, 0.62])).unwrap();
-        assert!(
-            c.explain().contains("at most 46° apart") && c.explain().contains("(p = 6.2e-1)"),
-            "{}",
-            c.explain()
-        );
-        assert_eq!(serde_json::to_value(&c).unwrap()["across"][0], 46.0);
-        // the anemometer logged: it measures the wind itself
-        assert!(bias_or_wind(&bias, Some(0.0007), true, None).is_none());
-        // several courses (at the level or above), or no heading to judge: none
-        assert!(bias_or_wind(&bias, Some(0.005), false, None).is_none());
-        assert!(bias_or_wind(&bias, None, false, None).is_none());
-        // no steady moment named
-        assert!(bias_or_wind(&[EffectKind::Asymmetry], Some(0.0007), false, None).is_none());
     }
 
     #[test]

@@ -362,14 +362,16 @@ pub fn diagnose(
     cfg: &DiagnoseConfig,
 ) -> Result<Diagnosis, DiagnoseError> {
     check(model, reference, est, val, cfg)?;
-    // trials noisier than the reference: measured against the reference given their noise
+    // trials noisier than the reference: against it given their noise; quieter: given its
+    let quiet = noise::quieted_trials(reference, est, cfg);
+    let quiet = quiet.as_ref();
     if let Some(m) = noise::matched_reference(model, reference, est, cfg) {
-        let mut d = run(&m.model, &m.reference, est, val, cfg, Against::Given)?;
+        let mut d = run(&m.model, &m.reference, est, None, val, cfg, Against::Given)?;
         caveat::append_words(&mut d.explanation, std::slice::from_ref(&m.caveat));
         d.caveats.push(m.caveat);
         return Ok(d);
     }
-    run(model, reference, est, val, cfg, Against::Given)
+    run(model, reference, est, quiet, val, cfg, Against::Given)
 }
 
 /// Which reference a run of the method measures the trials against.
@@ -388,6 +390,7 @@ fn run(
     model: &Model,
     reference: &[Record],
     est: &[Record],
+    quiet: Option<&noise::Quieted>,
     val: &[Record],
     cfg: &DiagnoseConfig,
     against: Against,
@@ -397,15 +400,17 @@ fn run(
     // call, with the intermediate results they share held here.
     let reps = cfg.null_reps.max(8);
     let given = [est, reference, val];
+    // quieter trials given the reference's noise (`quiet`) for the statistics, not the channels
+    let (logged, est) = (est, quiet.map_or(est, |q| &q.trials[..]));
     // long sets are diagnosed on blocks spread over them (see `WINDOW`)
     let windows = [window(est), window(reference), window(val)];
     // the heading, speed-over-ground and anemometer channels read the records whole (thinned
     // beyond `CHANNEL_WINDOW`): a channel's calibration compares each record with the others
     // of its set, and blocks of one record against each other span too few headings (a
     // current of 1.4 m/s missed at Ts 0.25 s, its resolution 3.1 m/s)
-    let whole = [channel_records(est), channel_records(reference)];
+    let whole = [channel_records(logged), channel_records(reference)];
     let whole = (
-        whole[0].as_deref().unwrap_or(est),
+        whole[0].as_deref().unwrap_or(logged),
         whole[1].as_deref().unwrap_or(reference),
     );
     let [est, reference, val] = [
@@ -726,7 +731,7 @@ fn run(
         .into_iter()
         .chain(then.as_ref().map(|(e, _)| e.kind))
         .collect();
-    caveats.extend(caveat::bias_or_wind(
+    caveats.extend(separation::bias_or_wind(
         &named,
         ch.separation,
         ch.anemometer.is_some(),
@@ -747,6 +752,7 @@ fn run(
     caveats.extend(commands::slew_or_dead_time(&named, est));
     caveats.extend(steps.into_iter().chain(other));
     caveats.extend(noise::noise_gain(base, est, reference));
+    caveats.extend(quiet.map(|q| q.caveat.clone()));
     let then = then.map(|(e, _)| e.kind.name().to_string());
     if then.as_deref() == Some(EffectKind::Current.name()) {
         // a current named second: what speed over ground cannot show does not qualify it
@@ -763,8 +769,9 @@ fn run(
     if let Some((ratio, at)) = again {
         let against = Against::TrialsSpeed;
         // re-timed to a higher speed, a reference record is shorter: checked as the one given
-        let again = check(&at.model, &at.reference, given[0], given[2], cfg)
-            .and_then(|()| run(&at.model, &at.reference, given[0], given[2], cfg, against));
+        let (m, r) = (&at.model, &at.reference);
+        let again = check(m, r, given[0], given[2], cfg)
+            .and_then(|()| run(m, r, given[0], quiet, given[2], cfg, against));
         if let Ok(mut d) = again {
             let more: Vec<Caveat> = caveats
                 .iter()
@@ -848,26 +855,22 @@ fn resolutions(
         .collect()
 }
 
-/// The gains of `kind` its resolution is read along: all of them, but of the wind's the
-/// once-per-turn harmonic alone. A wind's moment is mostly that: the rudder that holds
-/// course against the hidden winds of the test worlds varies with heading once per turn by
-/// 0.6–1.9° and twice by 0.01–0.5°, and the twice-per-turn regressors, correlated with the
-/// once-per-turn ones over the headings sailed, would make the worst direction a mix no
-/// wind has.
+/// The gains of `kind` its resolution is read along: all, but of the wind's the once-per-turn
+/// harmonic alone, which a wind's moment mostly is (the rudder holding course against the
+/// test worlds' winds varies once per turn by 0.6–1.9°, twice by 0.01–0.5°); the regressors
+/// twice per turn, correlated with it over the headings sailed, would make the worst
+/// direction a mix no wind has.
 fn resolved_gains(kind: EffectKind) -> Vec<usize> {
+    use crate::effects::Regressor::{Cos1, Sin1};
     let gains = crate::effects::def(kind).gains;
-    let first: Vec<usize> = (0..gains.len())
-        .filter(|&j| {
-            matches!(
-                gains[j].1,
-                crate::effects::Regressor::Sin1 | crate::effects::Regressor::Cos1
-            )
-        })
+    let all = 0..gains.len();
+    let first: Vec<usize> = all
+        .clone()
+        .filter(|&j| matches!(gains[j].1, Sin1 | Cos1))
         .collect();
-    if kind == EffectKind::Wind && !first.is_empty() {
-        first
-    } else {
-        (0..gains.len()).collect()
+    match kind == EffectKind::Wind && !first.is_empty() {
+        true => first,
+        false => all.collect(),
     }
 }
 

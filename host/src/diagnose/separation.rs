@@ -3,8 +3,10 @@
 
 use nalgebra::DMatrix;
 
+use super::caveat::Caveat;
 use super::channels::turned;
 use crate::io::data::Record;
+use yawcast_shared::model::EffectKind;
 
 /// The least share of the heading harmonics' variance over which the yaw channel's
 /// heading-dependent moment counts ([`heading_separation`]): what three records keep that
@@ -89,6 +91,24 @@ pub(super) fn heading_separation(recs: &[Record]) -> Option<f64> {
     least.is_finite().then_some(least.max(0.0))
 }
 
+/// The caveat for a steady moment named (`named`: the verdict's effect and its second) on
+/// trials whose [`heading_separation`] (`separation`) is under
+/// [`MIN_HEADING_SEPARATION`], with no anemometer logged
+/// ([`Caveat::BiasOrWind`]): the counterpart of [`Caveat::CurrentOrWind`] for the yaw
+/// channel. Where the anemometer is logged it measures the wind itself.
+pub(super) fn bias_or_wind(
+    named: &[EffectKind],
+    separation: Option<f64>,
+    anemometer: bool,
+    across: Option<[f64; 2]>,
+) -> Option<Caveat> {
+    let s = separation.filter(|&s| s < MIN_HEADING_SEPARATION)?;
+    (!anemometer && named.contains(&EffectKind::Bias)).then_some(Caveat::BiasOrWind {
+        separation: s,
+        across,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -128,5 +148,43 @@ mod tests {
         let mut none = set(20.0);
         none[1].psi = None;
         assert_eq!(heading_separation(&none), None);
+    }
+
+    #[test]
+    fn a_steady_moment_on_one_course_without_an_anemometer_may_be_a_wind() {
+        let bias = [EffectKind::RateLimit, EffectKind::Bias];
+        // an autopilot's or a zig-zag's one course, no anemometer: the caveat
+        let c = bias_or_wind(&bias, Some(0.0007), false, None).unwrap();
+        assert_eq!(
+            c,
+            Caveat::BiasOrWind {
+                separation: 0.0007,
+                across: None
+            }
+        );
+        assert!(
+            c.explain().contains("keep 0.07 % of their variance"),
+            "{}",
+            c.explain()
+        );
+        let json = serde_json::to_value(&c).unwrap();
+        assert_eq!(json["caveat"], "bias-or-wind");
+        assert_eq!(json["separation"], 0.0007);
+        assert!(json.get("across").is_none(), "{json}");
+        // the records' courses compared: how far apart, and that no change showed
+        let c = bias_or_wind(&bias, Some(0.0007), false, Some([46.0, 0.62])).unwrap();
+        assert!(
+            c.explain().contains("at most 46° apart") && c.explain().contains("(p = 6.2e-1)"),
+            "{}",
+            c.explain()
+        );
+        assert_eq!(serde_json::to_value(&c).unwrap()["across"][0], 46.0);
+        // the anemometer logged: it measures the wind itself
+        assert!(bias_or_wind(&bias, Some(0.0007), true, None).is_none());
+        // several courses (at the level or above), or no heading to judge: none
+        assert!(bias_or_wind(&bias, Some(0.005), false, None).is_none());
+        assert!(bias_or_wind(&bias, None, false, None).is_none());
+        // no steady moment named
+        assert!(bias_or_wind(&[EffectKind::Asymmetry], Some(0.0007), false, None).is_none());
     }
 }

@@ -16,6 +16,7 @@ use crate::identify::pem::{self, PemConfig};
 use crate::sim::{simulate, NoiseSpec, Scenario, Ship, SimEffect};
 use crate::stats::{chi2_sf, standard_normal as gauss};
 
+mod noise;
 mod worlds;
 pub(crate) use worlds::world_records;
 
