@@ -67,15 +67,7 @@ pub(super) fn matched_reference(
     trials: &[Record],
     cfg: &DiagnoseConfig,
 ) -> Option<Matched> {
-    if reference.is_empty() || trials.is_empty() {
-        return None;
-    }
-    let (noise, _) = noise_and_spread(trials);
-    let (r_noise, _) = noise_and_spread(reference);
-    if !(noise.is_finite() && noise >= MATCH_FROM * r_noise) {
-        return None;
-    }
-    let added = (noise * noise - r_noise * r_noise).sqrt();
+    let (noise, r_noise, added) = noisier(trials, reference)?;
     let noisy = with_noise(reference, added, cfg.seed ^ 0x4e4f_4953_4552);
     let pcfg = pem::PemConfig {
         max_iter: REFIT_ITER,
@@ -127,15 +119,7 @@ pub(super) fn quieted_trials(
     trials: &[Record],
     cfg: &DiagnoseConfig,
 ) -> Option<Quieted> {
-    if reference.is_empty() || trials.is_empty() {
-        return None;
-    }
-    let (noise, _) = noise_and_spread(trials);
-    let (r_noise, _) = noise_and_spread(reference);
-    if !(r_noise.is_finite() && r_noise >= MATCH_FROM * noise) {
-        return None;
-    }
-    let added = (r_noise * r_noise - noise * noise).sqrt();
+    let (r_noise, noise, added) = noisier(reference, trials)?;
     Some(Quieted {
         trials: with_noise(trials, added, cfg.seed ^ 0x5155_4945_5445),
         caveat: Caveat::QuieterTrials {
@@ -144,6 +128,18 @@ pub(super) fn quieted_trials(
             added_noise_degps: added,
         },
     })
+}
+
+/// The white noise on the yaw rate of `noisy` and of `quiet` ([`noise_and_spread`]) and the
+/// white noise that brings the second to the first, `√(σ_n² − σ_q²)`, where the first is
+/// [`MATCH_FROM`] times the second or more (`None` where not, or where either set is empty).
+fn noisier(noisy: &[Record], quiet: &[Record]) -> Option<(f64, f64, f64)> {
+    if noisy.is_empty() || quiet.is_empty() {
+        return None;
+    }
+    let (n, _) = noise_and_spread(noisy);
+    let (q, _) = noise_and_spread(quiet);
+    (n.is_finite() && n >= MATCH_FROM * q).then(|| (n, q, (n * n - q * q).sqrt()))
 }
 
 /// `recs` with white noise of std `sigma` added to every finite yaw-rate sample, drawn from
@@ -368,17 +364,22 @@ mod tests {
         assert_eq!(noise_gain(&smooth, &trials, &[]), None);
     }
 
-    #[test]
-    fn trials_noisier_than_the_reference_are_measured_against_a_reference_as_noisy() {
-        // a slow hull; the reference's yaw rate carries 0.005 °/s of white noise, the
-        // trials' 0.03 °/s (a simulator's records against a ship's gyro)
-        let m = Model::new(
+    /// A slow hull: poles 0.99 and 0.999, the command's gain small.
+    fn slow_hull() -> Model {
+        Model::new(
             1.0,
             vec![-0.99 * 0.999, 0.99 + 0.999],
             vec![0.0, 0.0001],
             vec![0.5, 0.5],
         )
-        .unwrap();
+        .unwrap()
+    }
+
+    #[test]
+    fn trials_noisier_than_the_reference_are_measured_against_a_reference_as_noisy() {
+        // the reference's yaw rate carries 0.005 °/s of white noise, the
+        // trials' 0.03 °/s (a simulator's records against a ship's gyro)
+        let m = slow_hull();
         let trials: Vec<Record> = (0..2).map(|s| record(&m, 0.03, s)).collect();
         let reference: Vec<Record> = (2..4).map(|s| record(&m, 0.005, s)).collect();
         let cfg = DiagnoseConfig {
@@ -440,13 +441,7 @@ mod tests {
     fn trials_quieter_than_the_reference_are_given_its_noise() {
         // the reference's yaw rate carries 0.03 °/s of white noise, the trials' 0.005 °/s (a
         // simulator's noisy gyro against a tank's clean one)
-        let m = Model::new(
-            1.0,
-            vec![-0.99 * 0.999, 0.99 + 0.999],
-            vec![0.0, 0.0001],
-            vec![0.5, 0.5],
-        )
-        .unwrap();
+        let m = slow_hull();
         let reference: Vec<Record> = (0..2).map(|s| record(&m, 0.03, s)).collect();
         let trials: Vec<Record> = (2..4).map(|s| record(&m, 0.005, s)).collect();
         let cfg = DiagnoseConfig::default();
