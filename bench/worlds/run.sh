@@ -6,6 +6,7 @@
 #                       [--strengths LIST] [--effects LIST] [--jobs J] [--log-wind]
 #                       [--augment] [--won-back] [--trial-input KIND] [--ref-input KIND]
 #                       [--ts S] [--noise-scale K] [--trial-noise-scale K] [--duration S]
+#                       [--trial-heading-noise-scale K] [--trial-speed-noise-scale K]
 #                       [--trial-disturbance K] [--ref-disturbance K] [--ref-effect NAME]
 #                       [--ref-log-angle] [--trial-log-angle]
 #
@@ -51,6 +52,9 @@
 #   --trial-noise-scale K  the trials' (and the validation record's) sensors' noise times K
 #                     more (default 1; e.g. 4: a reference from a quiet simulator, trials
 #                     logged on board with a MEMS gyro)
+#   --trial-heading-noise-scale K, --trial-speed-noise-scale K  the trials' heading or
+#                     speed noise alone times K more (default 1; e.g. 5: a compass of 1°,
+#                     a GNSS speed of 0.1 m/s)
 #   --duration S      the length of every record, reference and trials (`simulate
 #                     --duration`; default 1 800 s)
 #   --trial-disturbance K  the background yaw disturbance of the trials (and the validation
@@ -96,6 +100,8 @@ refinput=prbs
 ts=""
 noisescale=1
 trialnoisescale=1
+trialheadk=1
+trialspeedk=1
 duration=""
 trialdist=""
 refdist=""
@@ -120,6 +126,8 @@ while [ $# -gt 0 ]; do
         --ts) ts="--ts $2"; shift 2 ;;
         --noise-scale) noisescale="$2"; shift 2 ;;
         --trial-noise-scale) trialnoisescale="$2"; shift 2 ;;
+        --trial-heading-noise-scale) trialheadk="$2"; shift 2 ;;
+        --trial-speed-noise-scale) trialspeedk="$2"; shift 2 ;;
         --duration) duration="--duration $2"; shift 2 ;;
         --trial-disturbance) trialdist="--disturbance $2"; shift 2 ;;
         --ref-disturbance) refdist="--disturbance $2"; shift 2 ;;
@@ -127,7 +135,7 @@ while [ $# -gt 0 ]; do
         --ref-design-speed) refdesign=1; shift ;;
         --ref-log-angle) refangle="--log-angle"; shift ;;
         --trial-log-angle) trialangle="--log-angle"; shift ;;
-        -h|--help) sed -n '2,76p' "$0"; exit 0 ;;
+        -h|--help) sed -n '2,80p' "$0"; exit 0 ;;
         *) echo "unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
@@ -139,9 +147,9 @@ mkdir -p "$work"
 export YAWCAST="$yawcast" WORK="$work" LOGWIND="$logwind" AUGMENT="$augment" WONBACK="$wonback"
 export TRIALINPUT="$trialinput" TSARG="$ts $duration"
 # the sensors' noise: the trials' (and the validation record's), the reference's
-scaled() { awk -v a="$1" -v k="$noisescale" -v t="${2:-1}" 'BEGIN { print a * k * t }'; }
+scaled() { awk -v a="$1" -v k="$noisescale" -v t="${2:-1}" -v u="${3:-1}" 'BEGIN { print a * k * t * u }'; }
 tk="$trialnoisescale"
-export TRIALNOISE="--gyro-noise $(scaled 0.03 "$tk") --heading-noise $(scaled 0.2 "$tk") --speed-noise $(scaled 0.02 "$tk") $trialdist $trialangle"
+export TRIALNOISE="--gyro-noise $(scaled 0.03 "$tk") --heading-noise $(scaled 0.2 "$tk" "$trialheadk") --speed-noise $(scaled 0.02 "$tk" "$trialspeedk") $trialdist $trialangle"
 refnoise=(--gyro-noise "$(scaled 0.02)" --heading-noise "$(scaled 0.1)" $refdist $refeffect $refangle)
 
 # a world's `simulate` arguments, one a line: NAME, NAME@L for the world scaled to L m,
@@ -288,7 +296,7 @@ xargs -P "$jobs" -L 1 bash -c 'case_run "$@"' _ <"$list" | sort >"$work/cases.ts
 secs=$(( $(date +%s) - start ))
 
 python3 - "$work/cases.tsv" "$secs" "$(nproc)" "$trialinput" "$refinput" "${ts#--ts }" \
-    "$noisescale" "${duration#--duration }" "$trialnoisescale" <<'EOF'
+    "$noisescale" "${duration#--duration }" "$trialnoisescale" "$trialheadk" "$trialspeedk" <<'EOF'
 import collections, sys
 allrows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
 rows = [r for r in allrows if "+" not in r[2]]
@@ -311,6 +319,10 @@ if sys.argv[7] != "1":
     print(f"Every sensor's noise times {sys.argv[7]}.\n")
 if sys.argv[9] != "1":
     print(f"The trials' sensors' noise times {sys.argv[9]} more than the reference's.\n")
+if sys.argv[10] != "1":
+    print(f"The trials' heading noise times {sys.argv[10]} more.\n")
+if sys.argv[11] != "1":
+    print(f"The trials' speed noise times {sys.argv[11]} more.\n")
 if sys.argv[8]:
     print(f"Every record {sys.argv[8]} s long.\n")
 if pairs:

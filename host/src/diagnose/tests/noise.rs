@@ -6,19 +6,8 @@ use super::*;
 /// Mariner's records as `bench/worlds/run.sh` sails them: the world's identification input,
 /// `noise` the gyro (°/s), heading (°) and speed (m/s) noise, the hidden effects given.
 fn mariner(noise: [f64; 3], effects: Vec<SimEffect>, seeds: &[u64]) -> Vec<Record> {
-    let w = crate::sim::World::new(crate::sim::WorldKind::Mariner, None).unwrap();
-    let sc = Scenario {
-        n_samples: 1800,
-        input: w.default_input(),
-        noise: NoiseSpec {
-            gyro_std_degps: noise[0],
-            heading_std_deg: noise[1],
-            speed_std_mps: noise[2],
-        },
-        effects,
-        ..Scenario::default()
-    };
-    w.simulate_many(&sc, seeds).unwrap()
+    let k = crate::sim::WorldKind::Mariner;
+    super::worlds::noisy_records(k, effects, seeds, false, noise)
 }
 
 /// Mariner's hidden effect `kind` at full strength.

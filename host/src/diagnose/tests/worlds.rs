@@ -21,20 +21,36 @@ fn world_records_with(
     seeds: &[u64],
     log_wind: bool,
 ) -> Vec<Record> {
+    noisy_records(kind, effects, seeds, log_wind, [0.03, 0.2, 0.02])
+}
+
+/// [`world_records_with`], with gyro, heading and speed noise `noise` (°/s, °, m/s).
+pub(super) fn noisy_records(
+    kind: crate::sim::WorldKind,
+    effects: Vec<SimEffect>,
+    seeds: &[u64],
+    log_wind: bool,
+    noise: [f64; 3],
+) -> Vec<Record> {
     let w = crate::sim::World::new(kind, None).unwrap();
     let sc = Scenario {
         n_samples: 1800,
         input: w.default_input(),
-        noise: NoiseSpec {
-            gyro_std_degps: 0.03,
-            heading_std_deg: 0.2,
-            speed_std_mps: 0.02,
-        },
+        noise: noise_spec(noise),
         effects,
         log_wind,
         ..Scenario::default()
     };
     w.simulate_many(&sc, seeds).unwrap()
+}
+
+/// Gyro, heading and speed noise `noise` (°/s, °, m/s) as a [`NoiseSpec`].
+fn noise_spec(noise: [f64; 3]) -> NoiseSpec {
+    NoiseSpec {
+        gyro_std_degps: noise[0],
+        heading_std_deg: noise[1],
+        speed_std_mps: noise[2],
+    }
 }
 
 /// The records of `sc` on world `w`, the anemometer logged, with gyro, heading and speed
@@ -43,11 +59,7 @@ fn world_records_with(
 /// `simulate` writes it beside the record (the anemometer's true wind needs it).
 fn sailed(w: &crate::sim::World, sc: Scenario, noise: [f64; 3], seeds: &[u64]) -> Vec<Record> {
     let sc = Scenario {
-        noise: NoiseSpec {
-            gyro_std_degps: noise[0],
-            heading_std_deg: noise[1],
-            speed_std_mps: noise[2],
-        },
+        noise: noise_spec(noise),
         log_wind: true,
         ..sc
     };
