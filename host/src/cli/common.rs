@@ -190,6 +190,12 @@ pub struct ReadArgs {
     /// missing sample is an error naming its row.
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub fill_gaps: usize,
+    /// Replace isolated spikes of the yaw rate (a logger's glitches: a sample that leaves
+    /// the lines through its neighbours on both sides by more than 8 times the noise and a
+    /// tenth of the yaw rate's range) by the value its neighbours make, and say which rows;
+    /// without it such a record is an error naming them.
+    #[arg(long)]
+    pub despike: bool,
     /// Without a rate gyro: the yaw rate is the heading's change over each sample,
     /// (ψ_t − ψ_{t−1})/Ts, the first sample taking the second's; a CSV's yaw-rate column or
     /// an NMEA log's ROT sentences are not read (NMEA: the HDT/HDG heading sets the grid,
@@ -248,6 +254,7 @@ impl Default for ReadArgs {
             resample: None,
             rate_from_heading: false,
             fill_gaps: 0,
+            despike: false,
             max_angle: Limits::default().angle_deg,
             max_rate: Limits::default().rate_degps,
             max_speed: Limits::default().speed_mps,
@@ -384,6 +391,19 @@ impl ReadArgs {
         if self.rate_from_heading {
             // the checks name the channel the rate was formed from
             cols.y = format!("{}'s change per sample (--rate-from-heading)", cols.psi);
+        }
+        if self.despike {
+            let s = data::despike(&mut rec.y);
+            if !s.is_empty() {
+                eprintln!(
+                    "warning: {}: column `{}`: {} spike(s) replaced by the value their \
+                     neighbours make (--despike), rows {}",
+                    path.display(),
+                    cols.y,
+                    s.len(),
+                    data::spike_rows(&s)
+                );
+            }
         }
         data::validate_record(&rec, path, &self.limits()?, &cols)?;
         Ok(rec)

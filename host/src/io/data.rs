@@ -13,6 +13,7 @@ mod checks;
 mod csv_file;
 mod gyro;
 mod heading;
+mod spikes;
 mod split;
 #[cfg(test)]
 mod tests;
@@ -33,6 +34,7 @@ pub use csv_file::{
 pub(crate) use csv_file::{uniform_grid, Dialect};
 pub use gyro::{gyro_offset, GyroOffset};
 pub use heading::{block_mean, heading_bias, HeadingBias};
+pub use spikes::{despike, spike_rows, spikes, Spike, NOISE_TIMES, RANGE_SHARE};
 pub use split::{split_at_gaps, Break, BreakKind, Piece, Split};
 pub(crate) use timestamp::days_from_civil;
 
@@ -226,6 +228,30 @@ pub enum DataError {
         what: &'static str,
         /// The option that sets the limit.
         option: &'static str,
+    },
+    /// The yaw rate leaves its neighbours and comes back within one sample by more than
+    /// noise and a ship's motion allow ([`spikes`]).
+    #[error(
+        "{path}: row {row}, column `{column}`: {value:.4} °/s where its neighbours make \
+         {fitted:.4}: an isolated spike (a logger's glitch?), which no ship's yaw rate makes \
+         between two samples; {count} such sample(s) in this record (rows {rows}). --despike \
+         replaces each by the value its neighbours make, and says which"
+    )]
+    Spike {
+        /// File concerned.
+        path: PathBuf,
+        /// 1-based data row of the first spike.
+        row: usize,
+        /// Column name.
+        column: String,
+        /// The value logged there (°/s).
+        value: f64,
+        /// The value its neighbours make (°/s).
+        fitted: f64,
+        /// How many spikes the record holds.
+        count: usize,
+        /// Their rows (1-based), the first ten.
+        rows: String,
     },
     /// A channel never moves, so nothing can be learnt from the record.
     #[error("{path}: column `{column}` {what}")]

@@ -53,6 +53,10 @@ fn bad_input_suite() {
         ("inf.csv", rows(&|i, l| set(i, 29, 2, "inf", l)).into_bytes()),
         ("huge_cell.csv", rows(&|i, l| set(i, 40, 2, "3.4e200", l)).into_bytes()),
         ("rudder.csv", rows(&|i, l| set(i, 12, 1, "2000000", l)).into_bytes()),
+        ("spike.csv", rows(&|i, l| {
+            let r: f64 = l.split(',').nth(2).unwrap().parse().unwrap();
+            set(i, 77, 2, &format!("{}", r + 5.0), l)
+        }).into_bytes()),
         ("zero.csv", rows(&|i, _| format!("{},0,0", t(i))).into_bytes()),
         ("flipped.csv", rows(&|i, l| {
             let c: Vec<&str> = l.split(',').collect();
@@ -127,6 +131,8 @@ fn bad_input_suite() {
         bad("3.4e200 cell, augment", "augment --model {model} --effect bias --data {d}/huge_cell.csv --out {d}/out --json {d}/out-summary.json", &["huge_cell.csv", "row 40"]),
         bad("2e6° rudder", "identify --data {d}/rudder.csv --out {d}/out", &["rudder.csv", "row 12", "delta_deg", "--max-angle"]),
         bad("2e6° rudder, compare", "compare --model {model} --data {d}/rudder.csv --json {d}/out-summary.json", &["rudder.csv", "row 12"]),
+        bad("gyro spike", "identify --data {d}/spike.csv --out {d}/out", &["spike.csv", "row 77", "r_degps", "spike", "--despike"]),
+        bad("gyro spike, diagnose reference", "diagnose --model {model} --data {d}/good.csv --reference {d}/spike.csv --json {d}/out-summary.json", &["spike.csv", "row 77", "--despike"]),
         bad("all-zero trial", "diagnose --model {model} --data {d}/zero.csv --reference {d}/good.csv --json {d}/out-summary.json", &["zero.csv", "constant"]),
         bad("command of the other sign, diagnose", "diagnose --model {d}/csv4.json --data {d}/flipped.csv --reference {d}/good.csv --json {d}/out-summary.json", &["trial record `flipped`", "with the command negated", "negate its command column"]),
         bad("command of the other sign, augment", "augment --model {d}/csv4.json --effect bias --data {d}/flipped.csv --out {d}/out --json {d}/out-summary.json", &["estimation record `flipped`", "negate its command column"]),

@@ -290,6 +290,9 @@ fn implausible_or_still_records_are_refused_before_any_work() {
             }))
             .collect::<Vec<_>>()
             .join("\n");
+        let mut spike = lines.clone();
+        let r: f64 = spike[75].split(',').nth(2).unwrap().parse().unwrap();
+        spike[75] = format!("{},10,{}", 74.0 * 0.5, r + 1.0);
         let mut dup = lines.clone();
         dup[0] = "t_s,delta_deg,r_degps,r_degps".into();
         for l in dup.iter_mut().skip(1) {
@@ -301,6 +304,7 @@ fn implausible_or_still_records_are_refused_before_any_work() {
             ("zero", zero, "constant", "delta_deg"),
             ("stuck", stuck, "constant", "r_degps"),
             ("dup", dup.join("\n"), "more than once", "r_degps"),
+            ("spike", spike.join("\n"), "row 75", "r_degps"),
         ]
     };
     for (name, text, what, col) in &cases {
@@ -321,8 +325,31 @@ fn implausible_or_still_records_are_refused_before_any_work() {
         assert!(!out.with_extension("postcard").exists(), "{name}");
         assert!(!out.with_extension("json").exists(), "{name}");
     }
-    // The limit is the user's to raise (a positive number).
+    // A spike is replaced with --despike, which names its row: the fits are the clean
+    // record's to within 0.05 pp, where without it the record is refused (above).
     let m = write_model(&d);
+    std::fs::write(d.join("clean.csv"), &good).unwrap();
+    let fits = |f: &str, extra: &[&str]| -> Vec<f64> {
+        let o = run_compare(m.to_str().unwrap(), d.join(f).to_str().unwrap(), extra);
+        assert_eq!(code(&o), 0, "{f}: {}", stderr(&o));
+        if !extra.is_empty() {
+            let e = stderr(&o);
+            assert!(e.contains("spike.csv") && e.contains("1 spike(s)"), "{e}");
+            assert!(e.contains("rows 75") && e.contains("--despike"), "{e}");
+        }
+        let last = stdout(&o).lines().last().unwrap().to_string();
+        last.split_whitespace()
+            .skip(1)
+            .map(|v| v.trim_end_matches('%').parse().unwrap())
+            .collect()
+    };
+    let (clean, despiked) = (fits("clean.csv", &[]), fits("spike.csv", &["--despike"]));
+    assert_eq!(clean.len(), despiked.len());
+    assert!(!clean.is_empty());
+    for (a, b) in clean.iter().zip(&despiked) {
+        assert!((a - b).abs() < 0.05, "{clean:?} {despiked:?}");
+    }
+    // The limit is the user's to raise (a positive number).
     let f = d.join("rudder.csv");
     let o = run(&[
         "compare",

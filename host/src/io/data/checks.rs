@@ -31,13 +31,14 @@ pub const MIN_COMMAND_SPAN_DEG: f64 = 0.05;
 /// Smallest span of the yaw rate for a record to carry information (deg/s).
 pub const MIN_RATE_SPAN_DEGPS: f64 = 1e-3;
 
-/// Checks a record before any work is done on it: every value within `limits`, and both the
-/// command and the yaw rate moving (a command held at one angle, or a yaw rate stuck at one
+/// Checks a record before any work is done on it: every value within `limits`, no isolated
+/// spike in the yaw rate ([`super::spikes`]), and both the command and the yaw rate moving (a command held at one angle, or a yaw rate stuck at one
 /// value, cannot be identified, tuned on, compared or diagnosed). `cols` names the columns
 /// in the messages; rows are 1-based samples of the record (for an NMEA log, of its grid).
 ///
 /// # Errors
 /// [`DataError::Implausible`] naming the row and column of the first value beyond a limit,
+/// [`DataError::Spike`] naming the first row where the yaw rate spikes ([`super::spikes`]),
 /// [`DataError::NoExcitation`] naming the column that never moves, or the heading, course or
 /// speed over ground column that holds one value (a speed: 0) while the yaw rate turns the
 /// ship through [`MIN_TURN_DEG`] or more.
@@ -89,6 +90,18 @@ pub fn validate_record(
         "a yaw rate (deg/s)",
         "--max-rate",
     )?;
+    let spikes = super::spikes(&rec.y);
+    if let Some(first) = spikes.first() {
+        return Err(DataError::Spike {
+            path: path.to_path_buf(),
+            row: first.index + 1,
+            column: cols.y.clone(),
+            value: first.value,
+            fitted: first.fitted,
+            count: spikes.len(),
+            rows: super::spike_rows(&spikes),
+        });
+    }
     if let Some(v) = &rec.speed {
         within(
             v,
