@@ -57,9 +57,9 @@ fn robust_scale(v: impl Iterator<Item = f64>) -> f64 {
 
 /// The spikes of the yaw rate `y` (module docs), each as [`despike`] would replace it, in
 /// order of their samples. The bound is measured once on `y` as logged (robust: spikes do
-/// not move a median). Samples next to each other that are both spikes (a glitch of
-/// opposite signs in a row) are both found and replaced from the samples around them; a
-/// rudder's bend beside a spike is not taken for one. The
+/// not move a median). Two spikes in a row, of opposite signs or the same, are both found
+/// and replaced from the samples around them; a rudder's bend beside a spike is not taken
+/// for one. The
 /// first two and last two samples, which lack two neighbours on one side, are not judged.
 /// Non-finite values, or fewer than 5 samples: none.
 ///
@@ -90,9 +90,18 @@ pub fn spikes(y: &[f64]) -> Vec<Spike> {
     // a spike bends its neighbours' lines too: a neighbour that is also a rudder's bend
     // can pass the bound beside it. So each sample past the bound is judged again against
     // the record with all of them replaced from the samples around them, itself as logged
-    let past: Vec<usize> = (2..n - 2)
+    let mut past: Vec<usize> = (2..n - 2)
         .filter(|&i| departure(y, i, y[i]) > bound)
         .collect();
+    // two in a row the same way: each leaves the lines through the two samples beyond the
+    // pair on either side
+    for i in 2..n.saturating_sub(3) {
+        if pair_departure(y, i) > bound {
+            past.extend([i, i + 1]);
+        }
+    }
+    past.sort_unstable();
+    past.dedup();
     let mut z = y.to_vec();
     fill(&mut z, &past);
     let at: Vec<usize> = past
@@ -108,6 +117,25 @@ pub fn spikes(y: &[f64]) -> Vec<Spike> {
             fitted: z[i],
         })
         .collect()
+}
+
+/// How far the samples `i` and `i + 1` both leave the lines through the two samples before
+/// and the two after the pair, the same way from both (as [`departure`]; the smaller of the
+/// four departures where all agree in sign, else 0; `2 ≤ i < len − 3`).
+fn pair_departure(y: &[f64], i: usize) -> f64 {
+    let slope_in = y[i - 1] - y[i - 2];
+    let slope_out = y[i + 3] - y[i + 2];
+    let d = [
+        y[i] - (y[i - 1] + slope_in),
+        y[i + 1] - (y[i - 1] + 2.0 * slope_in),
+        y[i] - (y[i + 2] - 2.0 * slope_out),
+        y[i + 1] - (y[i + 2] - slope_out),
+    ];
+    if d.iter().all(|v| *v > 0.0) || d.iter().all(|v| *v < 0.0) {
+        d.iter().fold(f64::INFINITY, |m, v| m.min(v.abs()))
+    } else {
+        0.0
+    }
 }
 
 /// How far the value `v` at sample `i` leaves the lines through `y`'s two neighbours on
@@ -235,17 +263,22 @@ mod tests {
             }
         }
         // five glitches of ±2 °/s found where they are, the yaw rate given back to within
-        // its noise; a burst of two in a row found both
+        // its noise; two in a row of opposite signs, and two of the same, found both
         let clean = yaw(1800, 0.02, 7);
         let mut y = clean.clone();
         let at = [100, 400, 401, 900, 1500];
         for (k, &i) in at.iter().enumerate() {
             y[i] += if k % 2 == 0 { 2.0 } else { -2.0 };
         }
+        y[1200] += 2.0;
+        y[1201] += 2.0;
         let s = despike(&mut y);
-        assert_eq!(s.iter().map(|s| s.index).collect::<Vec<_>>(), at.to_vec());
+        let mut all = at.to_vec();
+        all.extend([1200, 1201]);
+        all.sort_unstable();
+        assert_eq!(s.iter().map(|s| s.index).collect::<Vec<_>>(), all);
         assert_eq!(s[0].value.to_bits(), (clean[100] + 2.0).to_bits());
-        for &i in &at {
+        for &i in &all {
             assert!((y[i] - clean[i]).abs() < 0.1, "{i}: {} {}", y[i], clean[i]);
         }
         // a spike under the noise's bound is left: 0.1 °/s on 0.02 °/s of noise
