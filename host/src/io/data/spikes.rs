@@ -59,9 +59,8 @@ fn robust_scale(v: impl Iterator<Item = f64>) -> f64 {
 /// order of their samples. The bound is measured once on `y` as logged (robust: spikes do
 /// not move a median). Two spikes in a row, of opposite signs or the same, are both found
 /// and replaced from the samples around them; a rudder's bend beside a spike is not taken
-/// for one. The
-/// first two and last two samples, which lack two neighbours on one side, are not judged.
-/// Non-finite values, or fewer than 5 samples: none.
+/// for one. The first two and last two samples, which lack two neighbours on one side, are
+/// not judged. Non-finite values, or fewer than 5 samples: none.
 ///
 /// ```
 /// use yawcast::io::data::spikes;
@@ -165,8 +164,9 @@ fn fill(z: &mut [f64], set: &[usize]) {
             b += 1;
         }
         k += 1;
-        let left = (0..a).rev().filter(|j| !set.contains(j)).take(2);
-        let right = (b + 1..n).filter(|j| !set.contains(j)).take(2);
+        let kept = |j: &usize| set.binary_search(j).is_err();
+        let left = (0..a).rev().filter(kept).take(2);
+        let right = (b + 1..n).filter(kept).take(2);
         let pts: Vec<(f64, f64)> = left.chain(right).map(|j| (j as f64, z[j])).collect();
         for i in a..=b {
             z[i] = lagrange(&pts, i as f64);
