@@ -32,9 +32,10 @@ pub const MIN_COMMAND_SPAN_DEG: f64 = 0.05;
 pub const MIN_RATE_SPAN_DEGPS: f64 = 1e-3;
 
 /// Checks a record before any work is done on it: every value within `limits`, no isolated
-/// spike in the yaw rate ([`super::spikes`]), and both the command and the yaw rate moving (a command held at one angle, or a yaw rate stuck at one
-/// value, cannot be identified, tuned on, compared or diagnosed). `cols` names the columns
-/// in the messages; rows are 1-based samples of the record (for an NMEA log, of its grid).
+/// spike in the yaw rate ([`super::spikes`]), and both the command and the yaw rate moving
+/// (a command held at one angle, or a yaw rate stuck at one value, cannot be identified,
+/// tuned on, compared or diagnosed). `cols` names the columns in the messages; rows are
+/// 1-based samples of the record (for an NMEA log, of its grid).
 ///
 /// # Errors
 /// [`DataError::Implausible`] naming the row and column of the first value beyond a limit,
