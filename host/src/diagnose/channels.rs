@@ -465,9 +465,10 @@ pub(super) struct CrossEvidence {
     pub(super) cross_chi: f64,
     /// Inflation of the cross-track lane's χ² (≥ 1).
     pub(super) cross_inflation: f64,
-    /// χ² (2 df) of the difference between the two lanes' currents: large when what varies
-    /// with heading is not one uniform current.
+    /// χ² (2 df) of the two lanes' currents' difference: large where the set is no uniform one.
     pub(super) agree: f64,
+    /// How large the set is across the heading against along it.
+    pub(super) shape: Option<super::set_shape::SetShape>,
 }
 
 impl CrossEvidence {
@@ -701,6 +702,7 @@ fn combine_current(a: &LaneStat, x: &LaneStat) -> Option<CrossEvidence> {
         cross_chi: x.raw[0] / x.inflation[0],
         cross_inflation: x.inflation[0],
         agree,
+        shape: super::set_shape::SetShape::of(ca, &va, cx, &vx),
     })
 }
 

@@ -113,6 +113,7 @@ pub mod resid;
 mod rule;
 mod second;
 mod separation;
+mod set_shape;
 mod similar;
 #[cfg(test)]
 pub(crate) mod tests;

@@ -634,7 +634,7 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
         evidence(EffectKind::Bias, 1e-4, 1e-4, false),
         evidence(EffectKind::Wind, 2e-3, 4e-4, false),
     ];
-    current_or_wind(&mut ev, level, alpha, true, None);
+    current_or_wind(&mut ev, level, alpha, true, None, None);
     assert_eq!(
         kinds(&ev),
         [EffectKind::Wind, EffectKind::Current, EffectKind::Bias]
@@ -668,7 +668,7 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
         evidence(EffectKind::Wind, 1e-6, 0.3, true),
         evidence(EffectKind::Current, 1e-7, 0.05, true),
     ];
-    current_or_wind(&mut ev, level, alpha, true, None);
+    current_or_wind(&mut ev, level, alpha, true, None, None);
     assert_eq!(kinds(&ev), [EffectKind::Current, EffectKind::Wind]);
     assert_eq!(ev[1].p, 1e-6);
     // named from the ground track alone, without an anemometer: a caveat says a wind's
@@ -684,7 +684,7 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
         evidence(EffectKind::Current, 1e-7, 0.05, true),
         evidence(EffectKind::Wind, 1e-6, 0.3, true),
     ];
-    current_or_wind(&mut ev, level, alpha, true, Some(0.5));
+    current_or_wind(&mut ev, level, alpha, true, Some(0.5), None);
     assert_eq!(kinds(&ev), [EffectKind::Current, EffectKind::Wind]);
     assert!(current_without_anemometer(&ev, None).is_none());
     // an anemometer showing no wind outranks a yaw moment varying with heading: the
@@ -695,7 +695,7 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
         evidence(EffectKind::Wind, 7.4e-5, 2.5e-5, true),
         evidence(EffectKind::Current, 1.0, 0.3, false),
     ];
-    current_or_wind(&mut ev, level, alpha, true, Some(1.0));
+    current_or_wind(&mut ev, level, alpha, true, Some(1.0), None);
     assert_eq!(kinds(&ev), [EffectKind::Current, EffectKind::Wind]);
     assert_eq!(ev[1].p, 1.0);
     assert!(!ev[1].channel_material);
@@ -712,7 +712,7 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
         gated(EffectKind::Wind, 1e-6),
         gated(EffectKind::Current, 1e-7),
     ];
-    current_or_wind(&mut ev, level, alpha, true, None);
+    current_or_wind(&mut ev, level, alpha, true, None, None);
     assert_eq!(kinds(&ev), [EffectKind::Current, EffectKind::Wind]);
     // nothing shows a wind: not significant, whatever its speed harmonics' p
     assert_eq!(ev[1].p, 1.0);
@@ -737,14 +737,14 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
         gated(EffectKind::Wind, 2.5e-5),
         gated(EffectKind::Current, 0.77),
     ];
-    current_or_wind(&mut ev, level, alpha, true, None);
+    current_or_wind(&mut ev, level, alpha, true, None, None);
     assert!(ev.iter().all(|e| e.p >= level), "{ev:?}");
     // the same evidence with the yaw channel counted: a moment tested and found absent
     let mut ev = vec![
         evidence(EffectKind::Wind, 1e-6, 1.0, true),
         evidence(EffectKind::Current, 1e-7, 1.0, true),
     ];
-    current_or_wind(&mut ev, level, alpha, true, None);
+    current_or_wind(&mut ev, level, alpha, true, None, None);
     assert!(
         ev[0].words.contains("p = 1.0e0 (absent)"),
         "{}",
@@ -760,7 +760,7 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
             evidence(EffectKind::Current, p, 1e-9, true),
             evidence(EffectKind::Wind, p, 1e-9, true),
         ];
-        current_or_wind(&mut ev, level, alpha, speed, None);
+        current_or_wind(&mut ev, level, alpha, speed, None, None);
         assert_eq!(kinds(&ev), [EffectKind::Current, EffectKind::Wind]);
         assert_eq!(ev[1].p, p);
     }

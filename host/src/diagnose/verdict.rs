@@ -13,6 +13,7 @@ use super::compare::mean_fit;
 use super::evidence::{effect_with, horizon_of, Quad, Set, WorldStat};
 use super::null::{Null, Nulls};
 use super::rule::{gain_at, gains_at, Fits};
+use super::set_shape::SetShape;
 use super::{DiagnoseConfig, Ranked, SLOW_HORIZON};
 use crate::identify::model::{Effect, Model};
 use crate::identify::predict::Horizon;
@@ -263,7 +264,16 @@ pub(super) fn rank(
                 .unwrap_or(std::cmp::Ordering::Equal),
         )
     });
-    current_or_wind(ev, level, cfg.alpha, speed, anemometer);
+    // the ground track's shape is read where the trials' headings part the harmonics from
+    // each record's own offset: on records that each hold one course (zig-zags) the lanes'
+    // harmonics are their offsets (a hidden current read −0.17 ± 0.32 across its set along
+    // it on the container ship's ±20° zig-zags, seed 3)
+    let shape = ch
+        .sog
+        .and_then(|s| s.cross)
+        .and_then(|c| c.shape)
+        .filter(|_| ch.yaw_tells_heading());
+    current_or_wind(ev, level, cfg.alpha, speed, anemometer, shape);
     carried(ev, level);
     // an effect `current_or_wind` left not significant (a wind the anemometer rules out)
     // leaves the significant effects' ranks, their order kept: the encompassing test is
@@ -304,6 +314,7 @@ pub(super) fn current_or_wind(
     alpha: f64,
     speed: bool,
     anemometer: Option<f64>,
+    shape: Option<SetShape>,
 ) {
     let pos = |ev: &[Evidence], k: EffectKind| ev.iter().position(|e| e.kind == k);
     let (Some(ic), Some(iw)) = (pos(ev, EffectKind::Current), pos(ev, EffectKind::Wind)) else {
@@ -319,6 +330,20 @@ pub(super) fn current_or_wind(
     let (p_decide, wind) = match anemometer {
         Some(p) => (p, p < alpha),
         None => (p_moment, !undecided && p_moment < alpha),
+    };
+    // no anemometer, and no moment that turns the ship: the ground track's set tells a
+    // wind's drag and leeway, mostly along the heading, from a uniform current's, alike
+    // along and across it ([`SetShape`]) — where the ground track shows the set itself
+    let by_set = shape.filter(|sh| {
+        anemometer.is_none()
+            && !undecided
+            && !wind
+            && ev[ic].p_ground.is_some_and(|p| p < level)
+            && sh.p_uniform() < alpha
+    });
+    let (p_decide, wind) = match by_set {
+        Some(sh) => (sh.p_uniform(), true),
+        None => (p_decide, wind),
     };
     let (witness, turned, carried) = match anemometer {
         Some(_) => (
@@ -337,7 +362,9 @@ pub(super) fn current_or_wind(
              being turned, a current",
         ),
     };
-    let words = if undecided {
+    let words = if let Some(sh) = by_set {
+        sh.words(witness, &fmt_p(p_moment))
+    } else if undecided {
         format!(
             "; {witness}: not counted (the trials each hold one course), so the records cannot \
              tell whether the ship is turned, nor a current from a wind: wind is not counted, \
@@ -354,9 +381,11 @@ pub(super) fn current_or_wind(
     };
     ev[ic].words.push_str(&words);
     ev[iw].words.push_str(&words);
-    ev[ic].speed_only = !wind;
-    ev[iw].speed_only = !wind;
-    if anemometer.is_none() {
+    // named from the ground track alone: its shape, or no moment at all
+    let speed_only = !wind || by_set.is_some();
+    ev[ic].speed_only = speed_only;
+    ev[iw].speed_only = speed_only;
+    if anemometer.is_none() && by_set.is_none() {
         let m = if undecided {
             Moment::NotCounted
         } else {

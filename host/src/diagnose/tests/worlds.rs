@@ -818,3 +818,43 @@ fn a_tanker_of_a_third_family_reads_its_effects_and_says_what_wind_it_cannot_see
         );
     }
 }
+
+#[test]
+fn a_wind_too_weak_to_turn_the_ship_is_told_from_a_current_by_its_set() {
+    // The container ship with the canonical wind at half strength and no anemometer, sailed
+    // as the suite sails it (seed 3): the wind's yaw moment is under what the yaw channel
+    // shows (p = 1), and its drag and leeway set the ship over ground, so it was named a
+    // current. A uniform current sets the ship alike along and across its heading; the
+    // hull answers a wind's drag with its surge resistance and its side force with its
+    // sway resistance, several times stiffer, so the wind's set lies mostly along the
+    // heading (across it 0.2 of it here, a hidden current's 1.0–1.1): `wind`. The hidden
+    // current at half strength stays `current`
+    use crate::sim::WorldKind;
+    let k = WorldKind::Container;
+    let w = crate::sim::World::new(k, None).unwrap();
+    let reference = world_records(k, Vec::new(), &[900, 901, 902]);
+    let model = identify(&reference);
+    let cfg = DiagnoseConfig {
+        seed: 3,
+        ..DiagnoseConfig::default()
+    };
+    for (hidden, named) in [(EffectKind::Wind, "wind"), (EffectKind::Current, "current")] {
+        let trials = world_records(k, vec![w.hidden(hidden, 0.5)], &[300, 301, 302]);
+        let d = diagnose(&model, &reference, &trials, &[], &cfg).unwrap();
+        let wind = d.ranking.iter().find(|r| r.effect == "wind").unwrap();
+        println!(
+            "{hidden:?}: {} ({:?}): {}",
+            d.verdict, d.then, wind.evidence
+        );
+        assert_eq!(d.verdict, named, "{}", d.explanation);
+        let told = wind
+            .evidence
+            .contains("the ground track's set is not a uniform current's");
+        assert_eq!(told, hidden == EffectKind::Wind, "{}", wind.evidence);
+        let leeway = d
+            .caveats
+            .iter()
+            .any(|c| matches!(c, Caveat::CurrentOrLeeway { .. }));
+        assert_eq!(leeway, hidden == EffectKind::Current, "{:?}", d.caveats);
+    }
+}
