@@ -12,7 +12,7 @@ use nalgebra::{Matrix2, Vector2};
 /// and across its heading, `ratio` ≈ 1. A wind pushes the hull, and the hull answers its
 /// drag with its surge resistance and its side force with its sway resistance, several
 /// times larger: its set lies mostly along the heading, `ratio` well under 1 (the test
-/// worlds' winds 0.2–0.7, their currents 0.8–1.1: docs/method.md).
+/// worlds' winds 0.2–0.7, their currents 0.8–1.35: docs/method.md).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct SetShape {
     /// Across-heading set over along-heading set.
