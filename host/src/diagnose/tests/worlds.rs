@@ -858,3 +858,41 @@ fn a_wind_too_weak_to_turn_the_ship_is_told_from_a_current_by_its_set() {
         assert_eq!(leeway, hidden == EffectKind::Current, "{:?}", d.caveats);
     }
 }
+
+#[test]
+fn a_gear_somewhat_slower_than_the_references_is_told_from_a_dead_time() {
+    // The container ship's own gear slews at 2.5 °/s; a hidden slew limit at half strength,
+    // 2.1 °/s, lags its PRBS steps by a near-constant time. On a grid of 12 rates (the
+    // nearest 2.37) it read `dead-time`; on the grid of 25 its rate is read within its
+    // uncertainty, and a hidden dead time stays a dead time
+    use crate::sim::{SimEffect, WorldKind};
+    let k = WorldKind::Container;
+    let w = crate::sim::World::new(k, None).unwrap();
+    let reference = world_records(k, Vec::new(), &[900, 901, 902]);
+    let model = identify(&reference);
+    let cfg = DiagnoseConfig {
+        seed: 1,
+        ..DiagnoseConfig::default()
+    };
+    for kind in [EffectKind::RateLimit, EffectKind::DeadTime] {
+        let hidden = w.hidden(kind, 0.5);
+        let trials = world_records(k, vec![hidden], &[100, 101, 102]);
+        let d = diagnose(&model, &reference, &trials, &[], &cfg).unwrap();
+        let named = d.ranking.iter().find(|r| r.effect == d.verdict).unwrap();
+        println!(
+            "{hidden:?}: {} {:?} ± {:?}",
+            d.verdict, named.parameter, named.parameter_uncertainty
+        );
+        assert_eq!(d.verdict, kind.name(), "{}", d.explanation);
+        if let SimEffect::RateLimit { rate_degps } = hidden {
+            let (p, u) = (
+                named.parameter.unwrap(),
+                named.parameter_uncertainty.unwrap(),
+            );
+            assert!(
+                (p - rate_degps).abs() <= u && u < 0.5,
+                "{p} ± {u} against {rate_degps}"
+            );
+        }
+    }
+}
