@@ -14,6 +14,15 @@ pub(crate) fn world_records(
     world_records_with(kind, effects, seeds, false)
 }
 
+/// A test world, its effect-free reference (seeds 900–902, sailed as [`world_records`]
+/// sails them) and the model `identify` writes for it.
+fn world_reference(kind: crate::sim::WorldKind) -> (crate::sim::World, Vec<Record>, Model) {
+    let w = crate::sim::World::new(kind, None).unwrap();
+    let reference = world_records(kind, Vec::new(), &[900, 901, 902]);
+    let model = identify(&reference);
+    (w, reference, model)
+}
+
 /// [`world_records`], with the anemometer's columns logged or not.
 fn world_records_with(
     kind: crate::sim::WorldKind,
@@ -622,11 +631,9 @@ fn on_a_hull_nothing_was_chosen_on_the_hidden_effect_is_named_and_nothing_else()
     // effect-free trials read `wind` at p = 1.7e-7 (a constant moment made heading
     // harmonics by the headings the trials sailed); the diagnosis now reads the model
     // `identify` writes for the reference, and says so
-    use crate::sim::{World, WorldKind};
+    use crate::sim::WorldKind;
     let k = WorldKind::SeiunMaru;
-    let w = World::new(k, None).unwrap();
-    let reference = world_records(k, Vec::new(), &[900, 901, 902]);
-    let model = identify(&reference);
+    let (w, reference, model) = world_reference(k);
     assert!(model.effects.is_empty());
     let cfg = DiagnoseConfig {
         seed: 1,
@@ -776,13 +783,11 @@ fn a_tanker_of_a_third_family_reads_its_effects_and_says_what_wind_it_cannot_see
     // `none` with the same caveat; a slew limit in the gear is named
     use crate::sim::WorldKind;
     let k = WorldKind::EssoOsaka;
-    let w = crate::sim::World::new(k, None).unwrap();
+    let (w, reference, model) = world_reference(k);
     let cfg = DiagnoseConfig {
         seed: 1,
         ..DiagnoseConfig::default()
     };
-    let reference = world_records(k, Vec::new(), &[900, 901, 902]);
-    let model = identify(&reference);
     for (hidden, named) in [
         (None, "none"),
         (Some(EffectKind::Wind), "none"),
@@ -831,9 +836,7 @@ fn a_wind_too_weak_to_turn_the_ship_is_told_from_a_current_by_its_set() {
     // current at half strength stays `current`
     use crate::sim::WorldKind;
     let k = WorldKind::Container;
-    let w = crate::sim::World::new(k, None).unwrap();
-    let reference = world_records(k, Vec::new(), &[900, 901, 902]);
-    let model = identify(&reference);
+    let (w, reference, model) = world_reference(k);
     let cfg = DiagnoseConfig {
         seed: 3,
         ..DiagnoseConfig::default()
@@ -867,9 +870,7 @@ fn a_gear_somewhat_slower_than_the_references_is_told_from_a_dead_time() {
     // uncertainty, and a hidden dead time stays a dead time
     use crate::sim::{SimEffect, WorldKind};
     let k = WorldKind::Container;
-    let w = crate::sim::World::new(k, None).unwrap();
-    let reference = world_records(k, Vec::new(), &[900, 901, 902]);
-    let model = identify(&reference);
+    let (w, reference, model) = world_reference(k);
     let cfg = DiagnoseConfig {
         seed: 1,
         ..DiagnoseConfig::default()
