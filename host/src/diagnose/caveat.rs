@@ -5,6 +5,7 @@ use yawcast_shared::model::EffectKind;
 
 use super::channels::Channels;
 use super::rule::{GAIN_PP, NO_GAIN_PP};
+use super::set_shape::SetShape;
 use super::verdict::{effect_phrase, fmt_p, Evidence, Moment};
 use super::{MIN_SAMPLES, WINDOW, WINDOW_BLOCK};
 use crate::diagnose::augment::sig;
@@ -89,6 +90,11 @@ pub enum Caveat {
     CurrentOrLeeway {
         /// p-value of the yaw channel's heading-dependent moment (absent: ≥ α).
         p_moment: f64,
+        /// Where course over ground is logged: the ground track's set across the heading as
+        /// a ratio of its set along it, and that ratio's standard error — about 1 for a
+        /// uniform current, well under for a wind's drag and leeway; it did not decide.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        set_ratio: Option<[f64; 2]>,
     },
     /// A current named from speed over ground alone on trials that each hold one course,
     /// with no anemometer: the yaw channel cannot tell a heading-dependent moment from the
@@ -471,13 +477,18 @@ impl Caveat {
                 sig(*smallest_deg),
                 h = super::SLOW_HORIZON
             ),
-            Caveat::CurrentOrLeeway { p_moment } => format!(
+            Caveat::CurrentOrLeeway {
+                p_moment,
+                set_ratio,
+            } => format!(
                 "The current is seen on the ground track alone and no anemometer is logged: \
                  the wind's leeway sets a ship over ground as a current does, and the yaw \
-                 channel shows no heading-dependent moment (p {}) that would tell a wind. The \
+                 channel shows no heading-dependent moment (p {}) that would tell a wind.{} The \
                  records cannot tell a current from the leeway of a wind too weak to turn the \
                  ship; the anemometer's columns (apparent wind speed and angle) would.",
-                fmt_p(*p_moment)
+                fmt_p(*p_moment),
+                set_ratio.map_or(String::new(), |[ratio, se]| SetShape { ratio, se }
+                    .lean_words())
             ),
             Caveat::CurrentOrWind { separation } => format!(
                 "The current is seen on the ground track alone, no anemometer is logged, and \
@@ -758,17 +769,22 @@ fn resample_step(sets: [&[Record]; 3]) -> Option<f64> {
 /// counted): of the effects `named` (the verdict's evidence, then its second effect's), a
 /// current that the yaw channel's heading-dependent moment set apart from wind
 /// ([`super::verdict::current_or_wind`]) and found absent, or could not (`separation`: the
-/// trials' [`super::separation::heading_separation`]).
+/// trials' [`super::separation::heading_separation`]); with the ground track's `shape`,
+/// where it was read and did not decide ([`SetShape::of_channels`]).
 pub(super) fn current_without_anemometer<'a>(
     named: impl IntoIterator<Item = &'a Evidence>,
     separation: Option<f64>,
+    shape: Option<SetShape>,
 ) -> Option<Caveat> {
     named
         .into_iter()
         .filter(|e| e.kind == EffectKind::Current && e.speed_only)
         .find_map(|e| e.moment)
         .map(|m| match m {
-            Moment::Tested(p_moment) => Caveat::CurrentOrLeeway { p_moment },
+            Moment::Tested(p_moment) => Caveat::CurrentOrLeeway {
+                p_moment,
+                set_ratio: shape.map(|s| [s.ratio, s.se]),
+            },
             Moment::NotCounted => Caveat::CurrentOrWind {
                 separation: separation.unwrap_or(0.0),
             },

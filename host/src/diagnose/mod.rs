@@ -723,10 +723,9 @@ fn run(
         ));
     }
     let verdict_ev = ev.iter().find(|e| e.kind.name() == verdict_name);
-    caveats.extend(caveat::current_without_anemometer(
-        verdict_ev.into_iter().chain(then.as_ref().map(|(e, _)| e)),
-        ch.separation,
-    ));
+    let named_ev = verdict_ev.into_iter().chain(then.as_ref().map(|(e, _)| e));
+    let (sep, shape) = (ch.separation, set_shape::SetShape::of_channels(&ch));
+    caveats.extend(caveat::current_without_anemometer(named_ev, sep, shape));
     let named: Vec<EffectKind> = verdict_ev
         .map(|e| e.kind)
         .into_iter()

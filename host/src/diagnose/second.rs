@@ -186,7 +186,7 @@ mod tests {
         assert_eq!(d.verdict, "dead-time", "{}", d.explanation);
         assert_eq!(d.then.as_deref(), Some("current"), "{}", d.explanation);
         let leeway = d.caveats.iter().find_map(|c| match c {
-            Caveat::CurrentOrLeeway { p_moment } => Some(*p_moment),
+            Caveat::CurrentOrLeeway { p_moment, .. } => Some(*p_moment),
             _ => None,
         });
         // the moment's p (0.14 here) is what the test applied: absent at α

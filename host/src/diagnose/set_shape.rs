@@ -53,6 +53,38 @@ impl SetShape {
         )
     }
 
+    /// The shape the trials' ground track shows against the reference's, where it is read:
+    /// where the trials' headings part the harmonics from each record's own offset. On
+    /// records that each hold one course (zig-zags) the lanes' harmonics are their offsets
+    /// (a hidden current read −0.17 ± 0.32 across its set along it on the container ship's
+    /// ±20° zig-zags, seed 3).
+    pub(super) fn of_channels(ch: &super::channels::Channels) -> Option<SetShape> {
+        ch.sog
+            .and_then(|s| s.cross)
+            .and_then(|c| c.shape)
+            .filter(|_| ch.yaw_tells_heading())
+    }
+
+    /// What this shape says where it does not decide (a current named, its caveat
+    /// `current-or-leeway`): which of the two it leans to, and how far from deciding.
+    pub(super) fn lean_words(&self) -> String {
+        let how = if self.ratio < UNIFORM_SET_MIN {
+            format!(
+                "under a uniform current's {UNIFORM_SET_MIN:.2} or more, as a wind's drag and \
+                 leeway (mostly along the heading) would make it, but not far enough to tell \
+                 (p {} against a uniform current's set, short of the α that names a wind from it)",
+                super::verdict::fmt_p(self.p_uniform())
+            )
+        } else {
+            format!("as a uniform current's (about 1; {UNIFORM_SET_MIN:.2} or more)")
+        };
+        format!(
+            " The ground track's set across the heading is {:.2} ± {:.2} of its set along it: \
+             {how}.",
+            self.ratio, self.se
+        )
+    }
+
     /// The shape of the lanes' currents `along` and `across` (north, east; m/s) with their
     /// covariances; `None` where the along lane shows no set.
     pub(super) fn of(
@@ -164,7 +196,7 @@ mod tests {
             "{}",
             ev[0].words
         );
-        assert!(current_without_anemometer(&ev, None).is_none());
+        assert!(current_without_anemometer(&ev, None, None).is_none());
         // a uniform current's set (the container ship's: 1.03 ± 0.06), one whose shape the
         // records cannot tell (0.5 ± 0.3: z = 0.8), or the built-in ship's current, whose
         // inertia sees the ground velocity (0.81 ± 0.02): a current, as before, with its caveat
@@ -190,8 +222,12 @@ mod tests {
                 "{shape:?}"
             );
             assert_eq!(ev[0].p, 1e-9);
-            assert!(current_without_anemometer(&ev, None).is_some(), "{shape:?}");
+            assert!(
+                current_without_anemometer(&ev, None, None).is_some(),
+                "{shape:?}"
+            );
         }
+
         // the shape is not read where an anemometer decides, where the yaw channel's moment
         // already says wind, or where the ground track itself shows no set at the level (the
         // current then significant from its yaw channel only)
@@ -208,5 +244,69 @@ mod tests {
         assert_eq!(kinds(&ev), [EffectKind::Wind, EffectKind::Current]);
         assert!(ev[0].words.contains("present"), "{}", ev[0].words);
         assert!(!ev[0].speed_only);
+    }
+
+    #[test]
+    fn a_shape_that_does_not_decide_is_given_in_the_current_or_leeway_caveat() {
+        use crate::diagnose::caveat::Caveat;
+        let (level, alpha) = (0.01 / 10.0, 0.01);
+        // the container ship's half-strength wind, seed 2: a set 0.34 ± 0.23 across the
+        // heading of its set along it, z = 1.8 under a uniform current's 0.75, short of α:
+        // a current is named, and its caveat says which way the shape leans and how far
+        let lean = SetShape {
+            ratio: 0.34,
+            se: 0.23,
+        };
+        let p = crate::stats::normal_sf((UNIFORM_SET_MIN - 0.34) / 0.23);
+        assert!(p > alpha && p < 0.05, "{p}");
+        let mut ev = vec![
+            Evidence {
+                p_ground: Some(1e-9),
+                ..evidence(EffectKind::Current, 1e-9, 0.3, true)
+            },
+            evidence(EffectKind::Wind, 1e-8, 0.6, true),
+        ];
+        current_or_wind(&mut ev, level, alpha, true, None, Some(lean));
+        assert_eq!(ev[0].kind, EffectKind::Current);
+        let c = current_without_anemometer(&ev, None, Some(lean)).unwrap();
+        assert_eq!(
+            c,
+            Caveat::CurrentOrLeeway {
+                p_moment: 0.6,
+                set_ratio: Some([0.34, 0.23])
+            }
+        );
+        let json = serde_json::to_value(&c).unwrap();
+        assert_eq!(json["set_ratio"], serde_json::json!([0.34, 0.23]));
+        let words = c.explain();
+        for part in [
+            "0.34 ± 0.23 of its set along it",
+            "under a uniform current's 0.75 or more",
+            &format!("(p {} against", crate::diagnose::verdict::fmt_p(p)),
+            "The records cannot tell a current from the leeway",
+        ] {
+            assert!(words.contains(part), "{part}: {words}");
+        }
+        // a uniform current's shape (1.03 ± 0.06) says so; without course over ground the
+        // caveat has no shape, and its JSON no field for one
+        let uniform = SetShape {
+            ratio: 1.03,
+            se: 0.06,
+        };
+        let c = current_without_anemometer(&ev, None, Some(uniform)).unwrap();
+        assert!(
+            c.explain()
+                .contains("1.03 ± 0.06 of its set along it: as a uniform current's"),
+            "{}",
+            c.explain()
+        );
+        let c = current_without_anemometer(&ev, None, None).unwrap();
+        assert!(
+            !c.explain().contains("of its set along it"),
+            "{}",
+            c.explain()
+        );
+        let json = serde_json::to_value(&c).unwrap();
+        assert!(json.get("set_ratio").is_none(), "{json}");
     }
 }

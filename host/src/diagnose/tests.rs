@@ -642,7 +642,7 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
     assert!((ev[0].p - 8e-4).abs() < 1e-15, "{}", ev[0].p);
     assert!(ev[0].channel_material);
     assert!(ev[0].words.contains("present"), "{}", ev[0].words);
-    assert!(current_without_anemometer(&ev, None).is_none());
+    assert!(current_without_anemometer(&ev, None, None).is_none());
     // a current carries the ship: where the ground track shows none at the level, the yaw
     // channel's heading harmonic does not name one (the container ship's hidden steady
     // moment, seed 1: the current at p = 1.3e-5 from the yaw channel, its ground track at
@@ -674,19 +674,25 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
     // named from the ground track alone, without an anemometer: a caveat says a wind's
     // leeway would look the same, with the p applied (2 × 0.05); none for the wind, none
     // where an anemometer decided
-    let c = current_without_anemometer(&ev, None).unwrap();
-    assert_eq!(c, Caveat::CurrentOrLeeway { p_moment: 0.1 });
+    let c = current_without_anemometer(&ev, None, None).unwrap();
+    assert_eq!(
+        c,
+        Caveat::CurrentOrLeeway {
+            p_moment: 0.1,
+            set_ratio: None
+        }
+    );
     let json = serde_json::to_value(&c).unwrap();
     assert_eq!(json["caveat"], "current-or-leeway");
     assert!(c.explain().contains("p = 1.0e-1"), "{}", c.explain());
-    assert!(current_without_anemometer(&ev[1..], None).is_none());
+    assert!(current_without_anemometer(&ev[1..], None, None).is_none());
     let mut ev = vec![
         evidence(EffectKind::Current, 1e-7, 0.05, true),
         evidence(EffectKind::Wind, 1e-6, 0.3, true),
     ];
     current_or_wind(&mut ev, level, alpha, true, Some(0.5), None);
     assert_eq!(kinds(&ev), [EffectKind::Current, EffectKind::Wind]);
-    assert!(current_without_anemometer(&ev, None).is_none());
+    assert!(current_without_anemometer(&ev, None, None).is_none());
     // an anemometer showing no wind outranks a yaw moment varying with heading: the
     // built-in ship's effect-free ±20° zig-zags against its PRBS reference (seed 2) read
     // as wind at p 7.4e-5 from the yaw channel alone, the anemometer's true wind 0.00 m/s
@@ -720,7 +726,7 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
     assert!(ev[0].words.contains("not counted"), "{}", ev[0].words);
     assert!(!ev[0].words.contains("(absent)"), "{}", ev[0].words);
     assert_eq!(ev[0].moment, Some(Moment::NotCounted));
-    let c = current_without_anemometer(&ev, Some(0.0012)).unwrap();
+    let c = current_without_anemometer(&ev, Some(0.0012), None).unwrap();
     assert_eq!(c, Caveat::CurrentOrWind { separation: 0.0012 });
     let json = serde_json::to_value(&c).unwrap();
     assert_eq!(json["caveat"], "current-or-wind");
@@ -751,8 +757,11 @@ fn a_yaw_moment_names_wind_its_absence_a_current() {
         ev[0].words
     );
     assert_eq!(
-        current_without_anemometer(&ev, Some(0.0012)),
-        Some(Caveat::CurrentOrLeeway { p_moment: 1.0 })
+        current_without_anemometer(&ev, Some(0.0012), None),
+        Some(Caveat::CurrentOrLeeway {
+            p_moment: 1.0,
+            set_ratio: None
+        })
     );
     // without speed over ground, or with neither significant, nothing changes
     for (speed, p) in [(false, 1e-7), (true, 0.5)] {

@@ -264,15 +264,7 @@ pub(super) fn rank(
                 .unwrap_or(std::cmp::Ordering::Equal),
         )
     });
-    // the ground track's shape is read where the trials' headings part the harmonics from
-    // each record's own offset: on records that each hold one course (zig-zags) the lanes'
-    // harmonics are their offsets (a hidden current read −0.17 ± 0.32 across its set along
-    // it on the container ship's ±20° zig-zags, seed 3)
-    let shape = ch
-        .sog
-        .and_then(|s| s.cross)
-        .and_then(|c| c.shape)
-        .filter(|_| ch.yaw_tells_heading());
+    let shape = SetShape::of_channels(ch);
     current_or_wind(ev, level, cfg.alpha, speed, anemometer, shape);
     carried(ev, level);
     // an effect `current_or_wind` left not significant (a wind the anemometer rules out)
