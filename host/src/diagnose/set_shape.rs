@@ -227,7 +227,6 @@ mod tests {
                 "{shape:?}"
             );
         }
-
         // the shape is not read where an anemometer decides, where the yaw channel's moment
         // already says wind, or where the ground track itself shows no set at the level (the
         // current then significant from its yaw channel only)
