@@ -9,11 +9,19 @@
 # command uses the speed `--lag` samples earlier (default 10), so a 10-step prediction needs
 # no speed beyond its origin, as a predictor on the controller would have.
 #
+# A controller need not log the speed for this: in a turn the speed falls with the square of
+# the yaw rate, through the surge's time constant. `--turn-tau LIST` adds, per time constant
+# T (s), the command scaled the same way by a stand-in for the speed, Û = b₀ + b₁·s with s the
+# yaw rate squared through a first-order lag of T (s(t) = a·s(t−1) + (1 − a)·r(t)², a =
+# e^(−Ts/T), started at r(0)²) and b₀, b₁ fitted by least squares to the trials' logged speed
+# (the stand-in for a gain the identification would estimate from the yaw rate alone).
+#
 #   bench/speed-gain/run.sh [--yawcast PATH] [--work DIR] [--worlds LIST] [--seeds N]
-#                           [--lag K]
+#                           [--lag K] [--turn-tau LIST]
 #
 # Prints one line per world and seed: the oracle's 10-step fit, then the fits (1/10/50
-# steps) as logged and scaled, and the 10-step difference.
+# steps) as logged and scaled, and the 10-step difference; with --turn-tau, per T the fits
+# with the stand-in and their 10-step difference from the command as logged.
 set -euo pipefail
 {
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -22,6 +30,7 @@ work="$repo/target/bench-speed-gain"
 worlds="lng,kvlcc2,mariner"
 seeds=3
 lag=10
+taus=""
 while [ $# -gt 0 ]; do
     case "$1" in
         --yawcast) yawcast="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
@@ -29,7 +38,8 @@ while [ $# -gt 0 ]; do
         --worlds) worlds="$2"; shift 2 ;;
         --seeds) seeds="$2"; shift 2 ;;
         --lag) lag="$2"; shift 2 ;;
-        -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
+        --turn-tau) taus="$2"; shift 2 ;;
+        -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
         *) echo "unknown argument $1 (see --help)" >&2; exit 2 ;;
     esac
 done
@@ -54,6 +64,39 @@ for t, r in enumerate(rows[1:]):
 csv.writer(open(dst + ".tmp", "w", newline="")).writerows(out)
 import os
 os.replace(dst + ".tmp", dst)'
+# turn.py TAU LAG SUFFIX TRIAL… VAL: each record's command times (Û(t − LAG)/Ū)², Û the
+# stand-in fitted on the trials (all but the last file), written beside it with SUFFIX
+turn='import csv, math, os, sys
+tau, lag, suf, files = float(sys.argv[1]), int(sys.argv[2]), sys.argv[3], sys.argv[4:]
+def read(f):
+    rows = list(csv.reader(open(f)))
+    h = rows[0]
+    ir, iu, it = h.index("r_degps"), h.index("u_mps"), h.index("t_s")
+    ts = float(rows[2][it]) - float(rows[1][it])
+    a = math.exp(-ts / tau)
+    s, lp = None, []
+    for r in rows[1:]:
+        q = float(r[ir]) ** 2
+        s = q if s is None else a * s + (1 - a) * q
+        lp.append(s)
+    return rows, lp, [float(r[iu]) for r in rows[1:]]
+recs = [read(f) for f in files]
+xs = [x for _, lp, _ in recs[:-1] for x in lp]
+ys = [y for _, _, us in recs[:-1] for y in us]
+n, mx, my = len(xs), sum(xs) / len(xs), sum(ys) / len(ys)
+b1 = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+b0 = my - b1 * mx
+for f, (rows, lp, _) in zip(files, recs):
+    h = rows[0]
+    idl = h.index("delta_deg")
+    out = [h]
+    for t, r in enumerate(rows[1:]):
+        r = list(r)
+        r[idl] = repr(float(r[idl]) * ((b0 + b1 * lp[max(t - lag, 0)]) / my) ** 2)
+        out.append(r)
+    dst = f[:-4] + suf + ".csv"
+    csv.writer(open(dst + ".tmp", "w", newline="")).writerows(out)
+    os.replace(dst + ".tmp", dst)'
 mean_u='import csv, sys
 us = [float(r["u_mps"]) for f in sys.argv[1:] for r in csv.DictReader(open(f))]
 print(sum(us) / len(us))'
@@ -61,8 +104,14 @@ fits='import json, sys
 f = json.load(open(sys.argv[1]))["records"][0]["fit"]
 print("/".join(f"{f[k]:.2f}" for k in ("1", "10", "50")))'
 
-printf '| world | seed | oracle 10 | as logged 1/10/50 | scaled by (U/Ū)² 1/10/50 | Δ 10 steps (pp) |\n'
-printf '|---|---|---|---|---|---|\n'
+IFS=, read -r -a tau_list <<<"$taus"
+head='| world | seed | oracle 10 | as logged 1/10/50 | scaled by (U/Ū)² 1/10/50 | Δ 10 steps (pp) |'
+rule='|---|---|---|---|---|---|'
+for T in "${tau_list[@]}"; do
+    head="$head by the turn, T = $T s 1/10/50 | Δ 10 steps (pp) |"
+    rule="$rule---|---|"
+done
+printf '%s\n%s\n' "$head" "$rule"
 IFS=, read -r -a world_list <<<"$worlds"
 for w in "${world_list[@]}"; do
     for s in $(seq 1 "$seeds"); do
@@ -92,7 +141,20 @@ print(f"{o:.2f}")' "$d/val.json")
         diff=$(python3 -c 'import sys
 a, b = (float(x.split("/")[1]) for x in sys.argv[1:3])
 print(f"{b - a:+.2f}")' "$a" "$b")
-        printf '| %s | %s | %s | %s | %s | %s |\n' "$w" "$s" "$oracle" "$a" "$b" "$diff"
+        line="| $w | $s | $oracle | $a | $b | $diff |"
+        for T in "${tau_list[@]}"; do
+            python3 -c "$turn" "$T" "$lag" "-turn$T" "$d"/trial-[123].csv "$d/val.csv"
+            "$yawcast" identify --data "$d/trial-1-turn$T.csv" --data "$d/trial-2-turn$T.csv" \
+                --data "$d/trial-3-turn$T.csv" --out "$d/model-turn$T" >>"$d/log" 2>&1
+            "$yawcast" compare --model "$d/model-turn$T.postcard" --data "$d/val-turn$T.csv" \
+                --horizons 1,10,50 --json "$d/fit-turn$T.json" >>"$d/log" 2>&1
+            c=$(python3 -c "$fits" "$d/fit-turn$T.json")
+            dc=$(python3 -c 'import sys
+a, b = (float(x.split("/")[1]) for x in sys.argv[1:3])
+print(f"{b - a:+.2f}")' "$a" "$c")
+            line="$line $c | $dc |"
+        done
+        printf '%s\n' "$line"
     done
 done
 exit 0

@@ -1,0 +1,153 @@
+#!/usr/bin/env bash
+# What the speed lost in turns would add to the error won back, measured before it is built:
+# on the records of a `bench/worlds/run.sh --won-back` run, every effect case's reference,
+# trials and validation record get the command scaled by a stand-in for the speed from the
+# turn (as `run.sh --turn-tau`: Û = b₀ + b₁·s, s the yaw rate squared through a first-order
+# lag of T seconds, b₀ and b₁ fitted to the logged speed of the reference records for them,
+# of the trials for the trials and the validation record; the speed `--lag` samples
+# earlier). The reference model is identified again on the scaled reference, `augment
+# --effect auto` runs on the scaled records from it, and its model is scored at 10 steps on
+# the scaled validation record. The oracle and the best linear model are the run's own, on
+# the records as logged, so the figure is `run.sh`'s won back with the stand-in added to
+# the augmented model: (augmented − linear) / (oracle − linear), over the cases where the
+# linear model is ≥ 3 pp below the oracle.
+#
+#   bench/speed-gain/won-back.sh --runs DIR [--yawcast PATH] [--worlds LIST]
+#                                [--turn-tau T] [--lag K] [--jobs N]
+#
+# DIR is the `--work` of a `run.sh --won-back` run. Prints one line per case (world,
+# effect, strength, seed, oracle, linear, augmented as run, augmented with the stand-in,
+# both won back) and the median per world and strength of both.
+set -euo pipefail
+{
+repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+yawcast=""
+runs=""
+worlds=""
+tau=100
+lag=10
+jobs=2
+while [ $# -gt 0 ]; do
+    case "$1" in
+        --runs) runs="$(cd "$2" && pwd)"; shift 2 ;;
+        --yawcast) yawcast="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
+        --worlds) worlds="$2"; shift 2 ;;
+        --turn-tau) tau="$2"; shift 2 ;;
+        --lag) lag="$2"; shift 2 ;;
+        --jobs) jobs="$2"; shift 2 ;;
+        -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
+        *) echo "unknown argument $1 (see --help)" >&2; exit 2 ;;
+    esac
+done
+if [ -z "$runs" ]; then echo "--runs DIR is needed (see --help)" >&2; exit 2; fi
+if [ -z "$yawcast" ]; then
+    (cd "$repo" && cargo build -q --profile ci -p yawcast)
+    yawcast="${CARGO_TARGET_DIR:-$repo/target}/ci/yawcast"
+fi
+if [ -z "$worlds" ]; then
+    worlds=$(find "$runs" -mindepth 1 -maxdepth 1 -type d -printf '%f\n' | sort | paste -sd,)
+fi
+
+# turn.py TAU LAG SUFFIX FIT… -- FILE…: each FILE's command times (Û(t − LAG)/Ū)², Û fitted
+# on the FIT records' logged speed, written beside it with SUFFIX
+turn='import csv, math, os, sys
+tau, lag, suf = float(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
+k = sys.argv.index("--")
+fit, files = sys.argv[4:k], sys.argv[k + 1:]
+def read(f):
+    rows = list(csv.reader(open(f)))
+    h = rows[0]
+    ir, iu, it = h.index("r_degps"), h.index("u_mps"), h.index("t_s")
+    a = math.exp(-(float(rows[2][it]) - float(rows[1][it])) / tau)
+    s, lp = None, []
+    for r in rows[1:]:
+        q = float(r[ir]) ** 2
+        s = q if s is None else a * s + (1 - a) * q
+        lp.append(s)
+    return rows, lp, [float(r[iu]) for r in rows[1:]]
+fr = [read(f) for f in fit]
+xs = [x for _, lp, _ in fr for x in lp]
+ys = [y for _, _, us in fr for y in us]
+mx, my = sum(xs) / len(xs), sum(ys) / len(ys)
+b1 = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+b0 = my - b1 * mx
+for f in files:
+    rows, lp, _ = read(f)
+    idl = rows[0].index("delta_deg")
+    out = [rows[0]]
+    for t, r in enumerate(rows[1:]):
+        r = list(r)
+        r[idl] = repr(float(r[idl]) * ((b0 + b1 * lp[max(t - lag, 0)]) / my) ** 2)
+        out.append(r)
+    dst = f[:-4] + suf + ".csv"
+    csv.writer(open(dst + ".tmp", "w", newline="")).writerows(out)
+    os.replace(dst + ".tmp", dst)'
+export YAWCAST="$yawcast" RUNS="$runs" TAU="$tau" LAG="$lag" TURN="$turn"
+
+IFS=, read -r -a world_list <<<"$worlds"
+for w in "${world_list[@]}"; do
+    d="$runs/$w"
+    python3 -c "$turn" "$tau" "$lag" "-turn$tau" "$d"/ref-[123].csv -- "$d"/ref-[123].csv
+    "$yawcast" identify --data "$d/ref-1-turn$tau.csv" --data "$d/ref-2-turn$tau.csv" \
+        --data "$d/ref-3-turn$tau.csv" --out "$d/ref-turn$tau" >"$d/ref-turn$tau.log" 2>&1
+done
+
+# one case: WORLD CASEDIR → a tab-separated line, or nothing where the run scored none
+case_turn() {
+    local w="$1" c="$2" name seed
+    name=$(basename "$c")
+    seed="${name##*-}"
+    [ -f "$c/val-won.json" ] && [ -f "$c/val.json" ] || return 0
+    local x="-turn$TAU"
+    python3 -c "$TURN" "$TAU" "$LAG" "$x" "$c"/trial-[123].csv -- "$c"/trial-[123].csv \
+        "$c/val.csv"
+    local refs=() data=()
+    for i in 1 2 3; do
+        refs+=(--reference "$RUNS/$w/ref-$i$x.csv")
+        data+=(--data "$c/trial-$i$x.csv")
+    done
+    if "$YAWCAST" augment --model "$RUNS/$w/ref$x.postcard" --effect auto "${refs[@]}" \
+        "${data[@]}" --seed "$seed" --out "$c/won$x" >"$c/won$x.log" 2>&1 \
+        && "$YAWCAST" compare --model "$c/won$x.postcard" --data "$c/val$x.csv" \
+            --horizons 10 --json "$c/val-won$x.json" >>"$c/won$x.log" 2>&1; then
+        python3 -c 'import json, sys
+w, name, c = sys.argv[1:4]
+f = lambda m: json.load(open(f"{c}/val-{m}.json"))["records"][0]["fit"]["10"]
+o = json.load(open(f"{c}/val.json"))["records"][0]["oracle_fit_pct"]
+lin = max(f("linear"), f("ref"))
+e, st, s = name.rsplit("-", 2)
+a, t = f("won"), f(f"won-turn{sys.argv[4]}")
+print("\t".join([w, e, st, s] + [f"{x:.2f}" for x in (o, lin, a, t)]))' \
+            "$w" "$name" "$c" "$TAU"
+    fi
+}
+export -f case_turn
+
+for w in "${world_list[@]}"; do
+    find "$runs/$w" -mindepth 1 -maxdepth 1 -type d -name '*-*-*' ! -name 'none-*' \
+        -printf "$w %p\n"
+done | sort | xargs -P "$jobs" -L 1 bash -c 'case_turn "$@"' _ | sort >"$runs/turn$tau.tsv"
+
+python3 - "$runs/turn$tau.tsv" "$tau" "$lag" <<'EOF'
+import collections, statistics, sys
+rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
+print(f"| world | effect | strength | seed | oracle | linear | augmented | with the turn's "
+      f"speed (T = {sys.argv[2]} s, lag {sys.argv[3]}) | won back | with the turn's speed |")
+print("|---|---|---|---|---|---|---|---|---|---|")
+by = collections.defaultdict(list)
+for w, e, st, s, o, lin, a, t in rows:
+    o, lin, a, t = map(float, (o, lin, a, t))
+    if o - lin < 3.0:
+        continue
+    wa, wt = (a - lin) / (o - lin), (t - lin) / (o - lin)
+    by[(w, st)].append((wa, wt))
+    print(f"| {w} | {e} | {st} | {s} | {o:.2f} | {lin:.2f} | {a:.2f} | {t:.2f} | "
+          f"{100 * wa:.1f} % | {100 * wt:.1f} % |")
+print("\n| world | strength | cases with a loss ≥ 3 pp | median won back | with the turn's speed |")
+print("|---|---|---|---|---|")
+for (w, st), v in sorted(by.items()):
+    print(f"| {w} | {st} | {len(v)} | {100 * statistics.median(x for x, _ in v):.1f} % | "
+          f"{100 * statistics.median(y for _, y in v):.1f} % |")
+EOF
+exit 0
+}
