@@ -275,7 +275,7 @@ pub fn run(args: &AugmentArgs) -> Result<()> {
                 );
             }
             let check = if val.is_empty() { &est } else { &val };
-            let trial_effects: Vec<EffectKind> = kind.into_iter().chain(then).collect();
+            let trial_effects = augment::auto_kinds(kind, then, args.more);
             let (model, why) =
                 augment::own_base(&given, gear, &trial_effects, &reference, check, &cfg);
             if let Some(w) = why.explain(given.ts) {

@@ -88,7 +88,7 @@ pub use again::{reestimate, refit, Reestimated, Refitted};
 pub(crate) use agree::sig;
 pub use agree::{check_estimate, EstimateCheck};
 pub(crate) use auto::own_search;
-pub use auto::{own_base, OwnBase};
+pub use auto::{auto_kinds, own_base, OwnBase};
 pub use forward::{forward, forward_ranked, ForwardReport, Round, Tried};
 pub use judge::{HeldOutGain, Reason};
 pub use simulator::to_sim_effect;
