@@ -64,39 +64,8 @@ for t, r in enumerate(rows[1:]):
 csv.writer(open(dst + ".tmp", "w", newline="")).writerows(out)
 import os
 os.replace(dst + ".tmp", dst)'
-# turn.py TAU LAG SUFFIX TRIAL… VAL: each record's command times (Û(t − LAG)/Ū)², Û the
-# stand-in fitted on the trials (all but the last file), written beside it with SUFFIX
-turn='import csv, math, os, sys
-tau, lag, suf, files = float(sys.argv[1]), int(sys.argv[2]), sys.argv[3], sys.argv[4:]
-def read(f):
-    rows = list(csv.reader(open(f)))
-    h = rows[0]
-    ir, iu, it = h.index("r_degps"), h.index("u_mps"), h.index("t_s")
-    ts = float(rows[2][it]) - float(rows[1][it])
-    a = math.exp(-ts / tau)
-    s, lp = None, []
-    for r in rows[1:]:
-        q = float(r[ir]) ** 2
-        s = q if s is None else a * s + (1 - a) * q
-        lp.append(s)
-    return rows, lp, [float(r[iu]) for r in rows[1:]]
-recs = [read(f) for f in files]
-xs = [x for _, lp, _ in recs[:-1] for x in lp]
-ys = [y for _, _, us in recs[:-1] for y in us]
-n, mx, my = len(xs), sum(xs) / len(xs), sum(ys) / len(ys)
-b1 = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
-b0 = my - b1 * mx
-for f, (rows, lp, _) in zip(files, recs):
-    h = rows[0]
-    idl = h.index("delta_deg")
-    out = [h]
-    for t, r in enumerate(rows[1:]):
-        r = list(r)
-        r[idl] = repr(float(r[idl]) * ((b0 + b1 * lp[max(t - lag, 0)]) / my) ** 2)
-        out.append(r)
-    dst = f[:-4] + suf + ".csv"
-    csv.writer(open(dst + ".tmp", "w", newline="")).writerows(out)
-    os.replace(dst + ".tmp", dst)'
+# the command scaled by the stand-in, fitted on the trials (bench/speed-gain/turn.py)
+turn="$repo/bench/speed-gain/turn.py"
 mean_u='import csv, sys
 us = [float(r["u_mps"]) for f in sys.argv[1:] for r in csv.DictReader(open(f))]
 print(sum(us) / len(us))'
@@ -143,7 +112,8 @@ a, b = (float(x.split("/")[1]) for x in sys.argv[1:3])
 print(f"{b - a:+.2f}")' "$a" "$b")
         line="| $w | $s | $oracle | $a | $b | $diff |"
         for T in "${tau_list[@]}"; do
-            python3 -c "$turn" "$T" "$lag" "-turn$T" "$d"/trial-[123].csv "$d/val.csv"
+            python3 "$turn" "$T" "$lag" "-turn$T" "$d"/trial-[123].csv -- "$d"/trial-[123].csv \
+                "$d/val.csv"
             "$yawcast" identify --data "$d/trial-1-turn$T.csv" --data "$d/trial-2-turn$T.csv" \
                 --data "$d/trial-3-turn$T.csv" --out "$d/model-turn$T" >>"$d/log" 2>&1
             "$yawcast" compare --model "$d/model-turn$T.postcard" --data "$d/val-turn$T.csv" \

@@ -48,46 +48,13 @@ if [ -z "$worlds" ]; then
     worlds=$(find "$runs" -mindepth 1 -maxdepth 1 -type d -printf '%f\n' | sort | paste -sd,)
 fi
 
-# turn.py TAU LAG SUFFIX FIT… -- FILE…: each FILE's command times (Û(t − LAG)/Ū)², Û fitted
-# on the FIT records' logged speed, written beside it with SUFFIX
-turn='import csv, math, os, sys
-tau, lag, suf = float(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
-k = sys.argv.index("--")
-fit, files = sys.argv[4:k], sys.argv[k + 1:]
-def read(f):
-    rows = list(csv.reader(open(f)))
-    h = rows[0]
-    ir, iu, it = h.index("r_degps"), h.index("u_mps"), h.index("t_s")
-    a = math.exp(-(float(rows[2][it]) - float(rows[1][it])) / tau)
-    s, lp = None, []
-    for r in rows[1:]:
-        q = float(r[ir]) ** 2
-        s = q if s is None else a * s + (1 - a) * q
-        lp.append(s)
-    return rows, lp, [float(r[iu]) for r in rows[1:]]
-fr = [read(f) for f in fit]
-xs = [x for _, lp, _ in fr for x in lp]
-ys = [y for _, _, us in fr for y in us]
-mx, my = sum(xs) / len(xs), sum(ys) / len(ys)
-b1 = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
-b0 = my - b1 * mx
-for f in files:
-    rows, lp, _ = read(f)
-    idl = rows[0].index("delta_deg")
-    out = [rows[0]]
-    for t, r in enumerate(rows[1:]):
-        r = list(r)
-        r[idl] = repr(float(r[idl]) * ((b0 + b1 * lp[max(t - lag, 0)]) / my) ** 2)
-        out.append(r)
-    dst = f[:-4] + suf + ".csv"
-    csv.writer(open(dst + ".tmp", "w", newline="")).writerows(out)
-    os.replace(dst + ".tmp", dst)'
+turn="$repo/bench/speed-gain/turn.py"
 export YAWCAST="$yawcast" RUNS="$runs" TAU="$tau" LAG="$lag" TURN="$turn"
 
 IFS=, read -r -a world_list <<<"$worlds"
 for w in "${world_list[@]}"; do
     d="$runs/$w"
-    python3 -c "$turn" "$tau" "$lag" "-turn$tau" "$d"/ref-[123].csv -- "$d"/ref-[123].csv
+    python3 "$turn" "$tau" "$lag" "-turn$tau" "$d"/ref-[123].csv -- "$d"/ref-[123].csv
     "$yawcast" identify --data "$d/ref-1-turn$tau.csv" --data "$d/ref-2-turn$tau.csv" \
         --data "$d/ref-3-turn$tau.csv" --out "$d/ref-turn$tau" >"$d/ref-turn$tau.log" 2>&1
 done
@@ -99,7 +66,7 @@ case_turn() {
     seed="${name##*-}"
     [ -f "$c/val-won.json" ] && [ -f "$c/val.json" ] || return 0
     local x="-turn$TAU"
-    python3 -c "$TURN" "$TAU" "$LAG" "$x" "$c"/trial-[123].csv -- "$c"/trial-[123].csv \
+    python3 "$TURN" "$TAU" "$LAG" "$x" "$c"/trial-[123].csv -- "$c"/trial-[123].csv \
         "$c/val.csv"
     local refs=() data=()
     for i in 1 2 3; do
