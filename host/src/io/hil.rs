@@ -299,10 +299,19 @@ pub struct Device {
     /// The banner the firmware sent as it booted (under QEMU); `None` on a serial link to
     /// a firmware that was already running.
     pub banner: Option<DeviceMessage>,
+    /// The other end closed or reset the link.
+    dropped: bool,
+    /// A byte has arrived.
+    heard: bool,
 }
 
+/// Boots [`Device::qemu`] tries in all when QEMU closes or resets the UART before a byte.
+pub const QEMU_BOOTS: usize = 3;
+
 impl Device {
-    /// Boots `elf` in QEMU and waits for the banner.
+    /// Boots `elf` in QEMU and waits for the banner. A boot whose UART the other end closes
+    /// or resets before a byte arrives is tried again, on a fresh port, up to [`QEMU_BOOTS`]
+    /// times in all (a test run saw QEMU reset its socket once, with nothing in its log).
     ///
     /// # Errors
     /// [`HilError::NoQemu`], or [`HilError::Link`] when QEMU does not come up.
@@ -310,7 +319,25 @@ impl Device {
         if !qemu_available() {
             return Err(HilError::NoQemu);
         }
-        let link = |e: String| HilError::Link(e);
+        let mut boots = 1;
+        loop {
+            match Device::qemu_once(elf) {
+                Err((_, true)) if boots < QEMU_BOOTS => boots += 1,
+                Err((HilError::Link(m), true)) => {
+                    return Err(HilError::Link(format!(
+                        "{m} (QEMU closed or reset its UART before a byte came, in each of \
+                         {boots} boots)"
+                    )))
+                }
+                r => return r.map_err(|(e, _)| e),
+            }
+        }
+    }
+
+    /// One boot of [`Device::qemu`]; on failure the error, and whether the UART was closed
+    /// or reset before a byte arrived.
+    fn qemu_once(elf: &Path) -> Result<Device, (HilError, bool)> {
+        let link = |e: String| (HilError::Link(e), false);
         let port = TcpListener::bind("127.0.0.1:0")
             .and_then(|l| l.local_addr())
             .map_err(|e| link(format!("no free local port: {e}")))?
@@ -363,14 +390,18 @@ impl Device {
         d.log = Some(log);
         d.window = 32;
         if let Err(e) = d.expect_banner() {
+            let dropped = d.dropped && !d.heard;
             return Err(match e {
+                // tried again: the log, which QEMU left empty, goes with the device
+                HilError::Link(m) if dropped => link(m),
                 // QEMU's own output says why the firmware did not start: kept, and named
                 HilError::Link(m) => match d.log.take() {
                     Some(l) => link(format!("{m} (QEMU's output: {})", l.display())),
                     None => link(m),
                 },
-                e => e,
-            });
+                e => (e, false),
+            })
+            .map_err(|(e, _)| (e, dropped));
         }
         Ok(d)
     }
@@ -420,6 +451,8 @@ impl Device {
             log: None,
             window: 1,
             banner: None,
+            dropped: false,
+            heard: false,
         }
     }
 
@@ -493,9 +526,20 @@ impl Device {
             self.rx.resize(4096, 0);
             self.rx_pos = 0;
             match self.port.read(&mut self.rx) {
-                Ok(0) => return Err(link("UART closed".into())),
-                Ok(n) => self.rx.truncate(n),
-                Err(e) => return Err(link(format!("UART read: {e}"))),
+                Ok(0) => {
+                    self.dropped = true;
+                    return Err(link("UART closed".into()));
+                }
+                Ok(n) => {
+                    self.heard = true;
+                    self.rx.truncate(n);
+                }
+                Err(e) => {
+                    use std::io::ErrorKind::{BrokenPipe, ConnectionAborted, ConnectionReset};
+                    self.dropped =
+                        matches!(e.kind(), ConnectionReset | ConnectionAborted | BrokenPipe);
+                    return Err(link(format!("UART read: {e}")));
+                }
             }
         }
     }
@@ -841,6 +885,50 @@ mod tests {
                     PathBuf::from(v)
                 );
             }
+        }
+    }
+
+    /// A UART that gives its bytes, then ends the way its kind says (`UnexpectedEof`: closed).
+    #[derive(Debug)]
+    struct Ends(Vec<u8>, std::io::ErrorKind);
+
+    impl Read for Ends {
+        fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+            if self.0.is_empty() {
+                return match self.1 {
+                    std::io::ErrorKind::UnexpectedEof => Ok(0),
+                    k => Err(k.into()),
+                };
+            }
+            let n = self.0.len().min(buf.len());
+            buf[..n].copy_from_slice(&self.0[..n]);
+            self.0.drain(..n);
+            Ok(n)
+        }
+    }
+
+    impl Write for Ends {
+        fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+            Ok(buf.len())
+        }
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn a_link_closed_or_reset_before_a_byte_is_told_from_other_failures() {
+        use std::io::ErrorKind::{ConnectionReset, TimedOut, UnexpectedEof};
+        // (bytes first, how the link ends) → (dropped, heard)
+        for (bytes, end, want) in [
+            (vec![], ConnectionReset, (true, false)),
+            (vec![], UnexpectedEof, (true, false)),
+            (vec![], TimedOut, (false, false)),
+            (vec![7, 7], ConnectionReset, (true, true)),
+        ] {
+            let mut d = Device::over(Box::new(Ends(bytes, end)));
+            assert!(matches!(d.recv(), Err(HilError::Link(_))));
+            assert_eq!((d.dropped, d.heard), want, "{end:?}");
         }
     }
 }
