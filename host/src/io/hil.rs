@@ -391,17 +391,17 @@ impl Device {
         d.window = 32;
         if let Err(e) = d.expect_banner() {
             let dropped = d.dropped && !d.heard;
-            return Err(match e {
-                // tried again: the log, which QEMU left empty, goes with the device
-                HilError::Link(m) if dropped => link(m),
+            let e = match e {
                 // QEMU's own output says why the firmware did not start: kept, and named
-                HilError::Link(m) => match d.log.take() {
-                    Some(l) => link(format!("{m} (QEMU's output: {})", l.display())),
-                    None => link(m),
+                // (unless the boot is tried again: the log, which QEMU left empty, goes with
+                // the device)
+                HilError::Link(m) if !dropped => match d.log.take() {
+                    Some(l) => HilError::Link(format!("{m} (QEMU's output: {})", l.display())),
+                    None => HilError::Link(m),
                 },
-                e => (e, false),
-            })
-            .map_err(|(e, _)| (e, dropped));
+                e => e,
+            };
+            return Err((e, dropped));
         }
         Ok(d)
     }
