@@ -97,6 +97,7 @@ fn unit(kind: EffectKind, cubic: bool) -> &'static str {
         EffectKind::Asymmetry => "fraction",
         EffectKind::NonlinearDamping if cubic => "° of command per (°/s)³",
         EffectKind::NonlinearDamping => "° of command per (°/s)²",
+        EffectKind::SpeedLoss => "per (°/s)²",
         EffectKind::Wind | EffectKind::Current => "",
     }
 }

@@ -151,11 +151,12 @@ impl Problem<'_> {
             }
             accs = self.jac(&params, &x0);
             if !self.lay.heading
-                && self
-                    .lay
-                    .gains
-                    .iter()
-                    .all(|g| *g != crate::effects::Regressor::Damping)
+                && self.lay.gains.iter().all(|g| {
+                    !matches!(
+                        g,
+                        crate::effects::Regressor::Damping | crate::effects::Regressor::SpeedLoss
+                    )
+                })
             {
                 break;
             }
