@@ -18,7 +18,7 @@ use yawcast_shared::model::EffectKind;
 
 /// Hidden `speed-loss` at full strength: an extra surge resistance in turns
 /// `X = −x_rr·½ρL³d·r²` (non-dimensional `x_rr`); it scales linearly with the strength.
-pub const HIDDEN_X_RR: f64 = 0.3;
+pub const HIDDEN_X_RR: f64 = 0.1;
 
 /// Number of lags searched.
 const LAGS: usize = 6;

@@ -144,10 +144,9 @@ fn diagnose_names_a_hidden_dead_time_and_writes_stable_json() {
         samples >= 1.0 && (samples - samples.round()).abs() < 1e-9,
         "{p} s ± {unc}"
     );
-    // every kind diagnose tests (the speed lost in turns is the ship's own: not ranked)
     assert_eq!(
         v["ranking"].as_array().unwrap().len(),
-        yawcast::effects::DIAGNOSED
+        yawcast_shared::model::EffectKind::ALL.len()
     );
     for k in ["1", "5", "10", "20", "sim"] {
         assert!(v["before"]["fit"][k].is_number(), "{k}");
