@@ -16,11 +16,9 @@
 //! model has a `gyro-bias` effect (otherwise the value is used as is).
 //!
 //! State: `x̂ ∈ R^N`, a delay line of the last `d` commands (`d` = dead time, 0 without the
-//! effect), the actuator position `ũ_prev`, the heading `ψ̂` (deg), the speed-loss lag `s`.
-//! All start at zero. Steps 2 and 7 and the `ψ̂` term of step 8 apply only to a model with a
-//! heading effect (wind or current), the only readers of `ψ`; otherwise `ψ̂` keeps its value.
-//! `s` changes only with a speed-loss effect; a non-finite `s` makes `v`, hence `x̂`,
-//! non-finite (`0·∞` is NaN), so step 8 covers it.
+//! effect), the actuator position `ũ_prev`, the heading `ψ̂` (deg). All start at zero. Steps 2
+//! and 7 and the `ψ̂` term of step 8 apply only to a model with a heading effect (wind or
+//! current), the only readers of `ψ`; otherwise `ψ̂` keeps its value.
 //!
 //! [`Predictor::update_with_heading`]`(u, y, psi)`:
 //! 1. actuator: `δ = u(t−d)` (pop the delay line, push `u`; `δ = u` when `d = 0`);
@@ -31,12 +29,10 @@
 //! 2. heading: `ψ = psi` when given and finite, else `ψ̂`.
 //! 3. `ŷ = x̂_1 + d_y`; `y_used = y` if `y` is finite, else `ŷ`; the rate the hull turns at
 //!    `ρ = y_used − d_y` (`ρ = y_used` without a gyro offset).
-//! 4. speed-loss lag (that effect only): `s = Step::turn(s, ρ)` = `(keep·s) + ((1 − keep)·(ρ·ρ))`;
-//!    `v = Step::effective_input(ũ, ρ, ψ, s)` of `yawcast_shared::kernel`: `v = ũ`, then
+//! 4. `v = Step::effective_input(ũ, ρ, ψ)` of `yawcast_shared::kernel`: `v = ũ`, then
 //!    for each effect present, in library order, `v = v + β·φ` (bias, asymmetry, nonlinear
-//!    damping, the speed lost in turns `φ = ũ·s`, then wind and current from
-//!    `libm::sincosf` of `r = ψ·(π/180)` and of `r + r`), one term at a time as documented
-//!    there.
+//!    damping, then wind and current from `libm::sincosf` of `r = ψ·(π/180)` and of `r + r`),
+//!    one term at a time as documented there.
 //! 5. `e = y − ŷ` if `y` is finite; otherwise there is no correction
 //!    ([`UpdateStatus::SkippedCorrection`]) and `e = 0`.
 //! 6. with `s = (…((a_1·x̂_1 + a_2·x̂_2) + a_3·x̂_3) …) + a_N·x̂_N` (the model is in the
@@ -158,8 +154,6 @@ pub struct PredictorState<const N: usize> {
     pub u_prev: f32,
     /// Integrated heading ψ̂ in degrees.
     pub psi: f32,
-    /// The speed-loss lag `s` (the squared rate through the lag; zero without the effect).
-    pub turn: f32,
 }
 
 impl<const N: usize> PredictorState<N> {
@@ -170,7 +164,6 @@ impl<const N: usize> PredictorState<N> {
         delay_head: 0,
         u_prev: 0.0,
         psi: 0.0,
-        turn: 0.0,
     };
 }
 
@@ -342,7 +335,9 @@ impl<const N: usize> Predictor<N> {
             Some(p) if p.is_finite() && self.heading => p,
             _ => st.psi,
         };
-        let (v, rate) = self.effect_input(&mut st, u, y_used, heading);
+        let ut = self.actuator(&mut st, u);
+        let rate = self.minus_dy(y_used);
+        let v = self.effective_input(ut, rate, heading);
         let x = st.x;
         let s = self.row_dot(&x);
         for i in 0..N - 1 {
@@ -435,30 +430,11 @@ impl<const N: usize> Predictor<N> {
         ut
     }
 
-    /// Steps 1, 3 and 4 of a step with effects on `st`: the actuator on command `u`, the
-    /// rate the hull turns at from `y_used`, the speed-loss lag and the effective input at
-    /// heading `heading`; returns `(v, ρ)`. One body for the update and the prediction, so
-    /// the effect code is laid down once in flash (a call per step on a model with effects;
-    /// the effect-free path does not come here).
-    #[inline(never)]
-    fn effect_input(
-        &self,
-        st: &mut PredictorState<N>,
-        u: f32,
-        y_used: f32,
-        heading: f32,
-    ) -> (f32, f32) {
-        let ut = self.actuator(st, u);
-        let rate = self.minus_dy(y_used);
-        st.turn = self.fx.turn(st.turn, rate);
-        (self.effective_input(ut, rate, heading, st.turn), rate)
-    }
-
     /// `v = ũ + Σ β φ`, accumulated one term at a time in library order; `rate` is the
     /// rate the hull turns at (the gyro's less its offset).
     #[inline(always)]
-    fn effective_input(&self, ut: f32, rate: f32, psi: f32, turn: f32) -> f32 {
-        self.fx.effective_input(ut, rate, psi, turn)
+    fn effective_input(&self, ut: f32, rate: f32, psi: f32) -> f32 {
+        self.fx.effective_input(ut, rate, psi)
     }
 
     /// Predicts `out.len()` = H outputs ŷ(t+1|t) … ŷ(t+H|t) from the current state, with
@@ -545,7 +521,9 @@ impl<const N: usize> Predictor<N> {
         for (o, &u) in rest.iter_mut().zip(future_u) {
             let y_used = prev;
             let heading = st.psi;
-            let (v, rate) = self.effect_input(&mut st, u, y_used, heading);
+            let ut = self.actuator(&mut st, u);
+            let rate = self.minus_dy(y_used);
+            let v = self.effective_input(ut, rate, heading);
             let x = st.x;
             let s = self.row_dot(&x);
             for i in 0..N - 1 {
@@ -634,8 +612,7 @@ impl<const N: usize> Predictor<N> {
         let finite = state.x.iter().all(|v| v.is_finite())
             && state.delay.iter().take(d).all(|v| v.is_finite())
             && state.u_prev.is_finite()
-            && state.psi.is_finite()
-            && state.turn.is_finite();
+            && state.psi.is_finite();
         if head_ok && finite {
             self.st = state;
             Ok(())

@@ -179,51 +179,6 @@ fn each_effect_enters_as_specified() {
     );
 }
 
-/// The speed-loss lag reads the rate the hull turns at (less the gyro offset), keeps
-/// `keep` of its last value per step, and scales the actuator output: `v = ũ + β·(ũ·s)`;
-/// over a prediction it follows the predicted rate; a restored state must carry a finite lag.
-#[test]
-fn speed_loss_lag_follows_the_rate_and_scales_the_command() {
-    let sl = Effect::SpeedLoss {
-        beta: -0.25,
-        keep: 0.75,
-    };
-    let (u, y) = (3.0f32, -2.0f32);
-    // from s = 0: s = 0.75·0 + 0.25·(y·y) = 1
-    assert_eq!(
-        x_after_one(&[sl], u, y, None),
-        expected(u + -0.25 * (u * 1.0), y)
-    );
-    let m = model(&[sl, Effect::GyroBias { d_y: 0.5 }]);
-    let mut p = Predictor::<4>::new(&m).unwrap();
-    p.update(u, 2.5);
-    assert_eq!(p.state().turn, 0.25 * (2.0 * 2.0));
-    p.update(u, -1.5);
-    assert_eq!(p.state().turn, 0.75 * 1.0 + 0.25 * (2.0 * 2.0));
-    // prediction: each step's lag from the rate predicted for it, as an update with that
-    // rate as its measurement and no correction would
-    let fu = [1.0f32, -2.0, 4.0];
-    let mut out = [0.0f32; 4];
-    p.predict_into(&mut out, &fu).unwrap();
-    let mut st = p.state();
-    let mut by_hand = [out[0]; 4];
-    for j in 1..4 {
-        let (v, _) = p.effect_input(&mut st, fu[j - 1], by_hand[j - 1], 0.0);
-        let x = st.x;
-        let sum = p.row_dot(&x);
-        for i in 0..3 {
-            st.x[i] = x[i] + x[i + 1] + B[i] * v;
-        }
-        st.x[3] = x[3] + sum + B[3] * v;
-        by_hand[j] = st.x[0] + 0.5;
-    }
-    assert_eq!(out.map(f32::to_bits), by_hand.map(f32::to_bits));
-    assert_ne!(st.turn, p.state().turn);
-    let mut s = p.state();
-    s.turn = f32::NAN;
-    assert_eq!(p.restore(s), Err(PredictorError::InvalidState));
-}
-
 #[test]
 fn heading_integrates_rate_minus_gyro_bias() {
     let current = Effect::Current {

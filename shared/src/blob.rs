@@ -318,7 +318,7 @@ mod tests {
         let m = full_model();
         let mut buf = [0u8; MAX_BLOB_LEN];
         let blob = encode_blob(&m, &mut buf).unwrap();
-        assert_eq!(blob.len(), HEADER_LEN + 180 + TRAILER_LEN);
+        assert_eq!(blob.len(), HEADER_LEN + 171 + TRAILER_LEN);
         assert_eq!(decode_blob(blob), Ok(m));
     }
 

@@ -23,8 +23,6 @@ pub trait Real:
 {
     /// Zero.
     const ZERO: Self;
-    /// One.
-    const ONE: Self;
     /// π/180, rounded once to the type.
     const DEG2RAD: Self;
     /// `|x|` (`libm`).
@@ -35,7 +33,6 @@ pub trait Real:
 
 impl Real for f32 {
     const ZERO: f32 = 0.0;
-    const ONE: f32 = 1.0;
     const DEG2RAD: f32 = core::f32::consts::PI / 180.0;
     #[inline(always)]
     fn abs(self) -> f32 {
@@ -49,7 +46,6 @@ impl Real for f32 {
 
 impl Real for f64 {
     const ZERO: f64 = 0.0;
-    const ONE: f64 = 1.0;
     const DEG2RAD: f64 = core::f64::consts::PI / 180.0;
     #[inline(always)]
     fn abs(self) -> f64 {
@@ -97,8 +93,6 @@ pub struct Step<R> {
     pub wind: Option<[R; 4]>,
     /// Current gains of `sin ψ, cos ψ`.
     pub current: Option<[R; 2]>,
-    /// Speed lost in turns: its gain, the lag's `keep` and `1 − keep` (rounded once).
-    pub speed: Option<[R; 3]>,
 }
 
 impl<R: Real> Step<R> {
@@ -123,7 +117,6 @@ impl<R: Real> Step<R> {
             damp: None,
             wind: None,
             current: None,
-            speed: None,
         };
         for e in effects {
             match *e {
@@ -142,7 +135,6 @@ impl<R: Real> Step<R> {
                 } => s.wind = Some([beta_s2, beta_c2, beta_s1, beta_c1]),
                 Effect::Current { beta_s, beta_c } => s.current = Some([beta_s, beta_c]),
                 Effect::DeadBand { width } => s.band = Some(width),
-                Effect::SpeedLoss { beta, keep } => s.speed = Some([beta, keep, R::ONE - keep]),
             }
         }
         s
@@ -182,43 +174,21 @@ impl<R: Real> Step<R> {
         }
     }
 
-    /// The speed-loss lag's next value from its last, `turn`, and the rate the hull turns
-    /// at, `rate` = ρ: `(keep·turn) + ((1 − keep)·(ρ·ρ))`; `turn` itself without a
-    /// speed-loss effect.
-    ///
-    /// ```
-    /// use yawcast_shared::{kernel::Step, model::Effect};
-    /// let s = Step::new(&[Effect::SpeedLoss { beta: -0.5f64, keep: 0.75 }], 1.0);
-    /// assert_eq!(s.turn(4.0, 2.0), 4.0);
-    /// assert_eq!(s.turn(0.0, 2.0), 1.0);
-    /// assert_eq!(Step::<f64>::new(&[], 1.0).turn(3.0, 2.0), 3.0);
-    /// ```
-    #[inline(always)]
-    pub fn turn(&self, turn: R, rate: R) -> R {
-        match self.speed {
-            Some([_, keep, rest]) => keep * turn + rest * (rate * rate),
-            None => turn,
-        }
-    }
-
     /// `v = ũ + Σ β φ`, accumulated one term at a time in library order: bias, asymmetry
     /// (`φ = ũ` if `ũ > 0` else `+0`), damping (`ρ|ρ|` or `(ρ·ρ)·ρ` of `rate` = ρ, the
     /// rate the hull turns at: the measured yaw rate less the gyro's offset `d_y`, so that
-    /// an offset gyro does not move the hull's damping), the speed lost in turns
-    /// (`φ = ũ·turn`, `turn` the lag's value of this step, [`Step::turn`]), then with
+    /// an offset gyro does not move the hull's damping), then with
     /// `r = ψ·(π/180)`, `(sin r, cos r)` and `(sin 2r, cos 2r) = sin_cos(r + r)` the wind's
     /// four terms and the current's two.
     ///
     /// ```
     /// use yawcast_shared::{kernel::Step, model::Effect};
     /// let s = Step::new(&[Effect::Bias { beta: 0.5f64 }, Effect::Asymmetry { beta: 0.25 }], 1.0);
-    /// assert_eq!(s.effective_input(2.0, 0.0, 0.0, 0.0), 3.0);
-    /// assert_eq!(s.effective_input(-2.0, 0.0, 0.0, 0.0), -1.5);
-    /// let s = Step::new(&[Effect::SpeedLoss { beta: -0.25f64, keep: 0.5 }], 1.0);
-    /// assert_eq!(s.effective_input(2.0, 1.0, 0.0, 1.0), 1.5);
+    /// assert_eq!(s.effective_input(2.0, 0.0, 0.0), 3.0);
+    /// assert_eq!(s.effective_input(-2.0, 0.0, 0.0), -1.5);
     /// ```
     #[inline(always)]
-    pub fn effective_input(&self, ut: R, rate: R, psi: R, turn: R) -> R {
+    pub fn effective_input(&self, ut: R, rate: R, psi: R) -> R {
         let mut v = ut;
         if let Some(beta) = self.bias {
             v = v + beta;
@@ -234,9 +204,6 @@ impl<R: Real> Step<R> {
                 rate * rate.abs()
             };
             v = v + beta * phi;
-        }
-        if let Some([beta, _, _]) = self.speed {
-            v = v + beta * (ut * turn);
         }
         if self.heading() {
             let r = psi * R::DEG2RAD;
@@ -287,10 +254,6 @@ mod tests {
                 beta_c: r(0.6),
             },
             Effect::DeadBand { width: r(1.0) },
-            Effect::SpeedLoss {
-                beta: r(-0.25),
-                keep: r(0.75),
-            },
         ]
     }
 
@@ -310,7 +273,6 @@ mod tests {
         );
         assert_eq!(s.wind, Some([0.1, 0.2, 0.3, 0.4]));
         assert_eq!(s.current, Some([0.5, 0.6]));
-        assert_eq!(s.speed, Some([-0.25, 0.75, 0.25]));
         assert!(s.heading());
         let capped = Step::<f32>::new(&[Effect::DeadTime { samples: 200 }], 1.0);
         assert_eq!(capped.dead, MAX_DEAD_TIME);
@@ -368,23 +330,23 @@ mod tests {
     #[test]
     fn effective_input_by_hand() {
         let s = Step::new(&every::<f64>(), 1.0);
-        let (ut, y, psi, turn) = (2.0, 1.5, 30.0, 0.5);
+        let (ut, y, psi) = (2.0, 1.5, 30.0);
         let r = psi * core::f64::consts::PI / 180.0;
-        let mut v = ut + 0.5 + 0.25 * 2.0 - 0.125 * 1.5 * 1.5 - 0.25 * 2.0 * 0.5;
+        let mut v = ut + 0.5 + 0.25 * 2.0 - 0.125 * 1.5 * 1.5;
         let w = [0.1f32, 0.2, 0.3, 0.4].map(f64::from);
         let c = [0.5f32, 0.6].map(f64::from);
         v += w[0] * libm::sin(2.0 * r) + w[1] * libm::cos(2.0 * r);
         v += w[2] * libm::sin(r) + w[3] * libm::cos(r);
         v += c[0] * libm::sin(r) + c[1] * libm::cos(r);
-        let got = s.effective_input(ut, y, psi, turn);
+        let got = s.effective_input(ut, y, psi);
         assert!((got - v).abs() < 1e-12, "{got} {v}");
         let s32 = Step::new(&every::<f32>(), 1.0);
-        let got32 = s32.effective_input(2.0f32, 1.5, 30.0, 0.5);
+        let got32 = s32.effective_input(2.0f32, 1.5, 30.0);
         assert!((f64::from(got32) - v).abs() < 1e-5, "{got32} {v}");
         // asymmetry reads only a positive ũ, as +0
         let a = Step::new(&[Effect::Asymmetry { beta: 2.0f32 }], 1.0);
         assert_eq!(
-            a.effective_input(-1.0, 0.0, 0.0, 0.0).to_bits(),
+            a.effective_input(-1.0, 0.0, 0.0).to_bits(),
             (-1.0f32).to_bits()
         );
     }

@@ -41,7 +41,7 @@ pub const MIN_ORDER: usize = 2;
 /// Largest model order accepted.
 pub const MAX_ORDER: usize = 8;
 /// Largest number of effects one model may carry (one of each kind).
-pub const MAX_EFFECTS: usize = 11;
+pub const MAX_EFFECTS: usize = 10;
 /// Largest dead time, in samples, the firmware keeps a delay line for.
 pub const MAX_DEAD_TIME: u8 = 32;
 
@@ -158,20 +158,6 @@ pub enum Effect<R = f32> {
         /// Width b in input units, `> 0`.
         width: R,
     },
-    /// The rudder's force lost with the speed in turns: a turn costs a ship speed, the
-    /// speed follows the turn with the surge's own lag, and a slower ship turns less for
-    /// the same rudder. With `s` the squared rate the hull turns at (`ρ = y − d_y`) through
-    /// a first-order lag, `s(t) = keep·s(t−1) + (1 − keep)·ρ(t)²` (`s` starts at zero: a
-    /// record starts on a straight course), `φ = ũ·s` through B.
-    ///
-    /// Last in the enum so that the blob's variant indices of the other effects are those
-    /// of blobs written before it existed.
-    SpeedLoss {
-        /// Gain β (per (output unit)², negative when a turn slows the ship).
-        beta: R,
-        /// The lag's factor kept per sample, `e^(−Ts/T)` for a lag of T seconds, `0..1`.
-        keep: R,
-    },
 }
 
 /// The kind of an effect, without parameters.
@@ -199,13 +185,11 @@ pub enum EffectKind {
     Current,
     /// See [`Effect::DeadBand`].
     DeadBand,
-    /// See [`Effect::SpeedLoss`].
-    SpeedLoss,
 }
 
 impl EffectKind {
     /// Every kind, in library order.
-    pub const ALL: [EffectKind; 11] = [
+    pub const ALL: [EffectKind; 10] = [
         EffectKind::Bias,
         EffectKind::GyroBias,
         EffectKind::DeadTime,
@@ -216,7 +200,6 @@ impl EffectKind {
         EffectKind::Wind,
         EffectKind::Current,
         EffectKind::DeadBand,
-        EffectKind::SpeedLoss,
     ];
 
     /// The stable name used on the command line and in JSON.
@@ -237,7 +220,6 @@ impl EffectKind {
             EffectKind::Wind => "wind",
             EffectKind::Current => "current",
             EffectKind::DeadBand => "dead-band",
-            EffectKind::SpeedLoss => "speed-loss",
         }
     }
 
@@ -270,8 +252,7 @@ impl EffectKind {
             | EffectKind::Asymmetry
             | EffectKind::NonlinearDamping
             | EffectKind::Wind
-            | EffectKind::Current
-            | EffectKind::SpeedLoss => false,
+            | EffectKind::Current => false,
         }
     }
 
@@ -291,8 +272,7 @@ impl EffectKind {
             | EffectKind::Saturation
             | EffectKind::Asymmetry
             | EffectKind::NonlinearDamping
-            | EffectKind::DeadBand
-            | EffectKind::SpeedLoss => false,
+            | EffectKind::DeadBand => false,
         }
     }
 }
@@ -316,7 +296,6 @@ impl<R> Effect<R> {
             Effect::Wind { .. } => EffectKind::Wind,
             Effect::Current { .. } => EffectKind::Current,
             Effect::DeadBand { .. } => EffectKind::DeadBand,
-            Effect::SpeedLoss { .. } => EffectKind::SpeedLoss,
         }
     }
 
@@ -356,10 +335,6 @@ impl<R> Effect<R> {
                 beta_c: f(beta_c),
             },
             Effect::DeadBand { width } => Effect::DeadBand { width: f(width) },
-            Effect::SpeedLoss { beta, keep } => Effect::SpeedLoss {
-                beta: f(beta),
-                keep: f(keep),
-            },
         }
     }
 }
@@ -393,10 +368,6 @@ pub const EVERY_EFFECT: [Effect; EffectKind::ALL.len()] = [
         beta_c: 0.1,
     },
     Effect::DeadBand { width: 0.75 },
-    Effect::SpeedLoss {
-        beta: -0.02,
-        keep: 0.99,
-    },
 ];
 
 /// A complete model as exported to the controller (all numbers `f32`), in the difference
@@ -697,7 +668,6 @@ fn effect_ok(e: &Effect) -> bool {
         } => sane(beta_s2) && sane(beta_c2) && sane(beta_s1) && sane(beta_c1),
         Effect::Current { beta_s, beta_c } => sane(beta_s) && sane(beta_c),
         Effect::DeadBand { width } => sane(width) && width > 0.0,
-        Effect::SpeedLoss { beta, keep } => sane(beta) && (0.0..1.0).contains(&keep),
     }
 }
 

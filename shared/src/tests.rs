@@ -8,7 +8,7 @@ use crate::blob::{
     MAX_BLOB_LEN,
 };
 use crate::crc::crc32;
-use crate::model::{Effect, EffectKind, ModelError, ModelSpec, Units};
+use crate::model::{Effect, ModelSpec, Units};
 use crate::nav::{TrackError, TrackField, TrackSpec};
 use crate::wire::{
     AckStatus, DeviceMessage, ErrorCode, Feed, FrameAccumulator, HostMessage, NavStatus, WireError,
@@ -55,49 +55,6 @@ fn reference_blob_bytes() {
     assert_eq!(blob, &REFERENCE_BLOB[..]);
     assert_eq!(crc32(&REFERENCE_BLOB[8..69]), 0xe05e_60bf);
     assert_eq!(decode_blob(&REFERENCE_BLOB), Ok(reference_model()));
-}
-
-/// The reference model with a speed lost in turns as well (its variant index 10, last in the
-/// library), byte for byte.
-const SPEED_LOSS_BLOB: [u8; 82] = [
-    0x59, 0x41, 0x57, 0x43, // "YAWC"
-    0x02, 0x00, // version 2
-    0x46, 0x00, // payload length 70
-    0x04, 0x00, 0x00, 0x00, 0x3f, 0x04, 0x9a, 0x99, 0x19, 0xbf, 0x66, 0x66, 0x26, 0xc0, 0x00, 0x00,
-    0x90, 0xc0, 0x9a, 0x99, 0x59, 0xc0, 0x04, 0x0a, 0xd7, 0x23, 0x3c, 0x0a, 0xd7, 0x23, 0x3c, 0x0a,
-    0xd7, 0xa3, 0x3b, 0x6f, 0x12, 0x03, 0x3b, 0x04, 0xcd, 0xcc, 0xcc, 0x3d, 0x0a, 0xd7, 0x23, 0x3c,
-    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
-    0x00, // the model, as in REFERENCE_BLOB
-    0x02, // two effects
-    0x02, 0x02, // DeadTime { samples: 2 }
-    0x0a, 0x00, 0x00, 0x80, 0xbe, 0x00, 0x00, 0x40,
-    0x3f, // SpeedLoss { beta: −0.25, keep: 0.75 }
-    0xca, 0xaa, 0x79, 0xd1, // CRC-32
-];
-
-#[test]
-fn speed_loss_blob_bytes() {
-    let effects = [
-        Effect::DeadTime { samples: 2 },
-        Effect::SpeedLoss {
-            beta: -0.25,
-            keep: 0.75,
-        },
-    ];
-    let r = reference_model();
-    let m = ModelSpec::new(4, r.ts, &r.a, &r.b, &r.k, r.units, &effects).unwrap();
-    let mut buf = [0u8; MAX_BLOB_LEN];
-    assert_eq!(encode_blob(&m, &mut buf).unwrap(), &SPEED_LOSS_BLOB[..]);
-    assert_eq!(decode_blob(&SPEED_LOSS_BLOB), Ok(m));
-    // a lag that keeps all (or more) of its value is refused
-    let bad = [Effect::SpeedLoss {
-        beta: -0.25,
-        keep: 1.0,
-    }];
-    assert_eq!(
-        ModelSpec::new(4, r.ts, &r.a, &r.b, &r.k, r.units, &bad),
-        Err(ModelError::EffectParameter(EffectKind::SpeedLoss))
-    );
 }
 
 /// The reference model's track part (values exact in binary).

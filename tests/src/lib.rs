@@ -44,11 +44,10 @@ pub fn with_effects(effects: &[Effect]) -> ModelSpec {
     .expect("reference model validates")
 }
 
-/// The thirteen reference models: the base model, the base model with each effect, and the
+/// The twelve reference models: the base model, the base model with each effect, and the
 /// base model with every effect of format 2's first release stacked (as `yawcast augment
-/// --more` builds them); the dead band and the speed lost in turns (with a gyro offset, so
-/// its lag reads the rate less the offset) came later and have their own records, so the
-/// older golden files stay as they were written.
+/// --more` builds them); the dead band came later and has its own record, so the older
+/// golden files stay as they were written.
 pub fn reference_models() -> Vec<(&'static str, ModelSpec)> {
     vec![
         ("base", base_model()),
@@ -98,16 +97,6 @@ pub fn reference_models() -> Vec<(&'static str, ModelSpec)> {
             with_effects(&[
                 Effect::DeadBand { width: 1.5 },
                 Effect::RateLimit { rate: 5.0 },
-            ]),
-        ),
-        (
-            "speed-loss",
-            with_effects(&[
-                Effect::SpeedLoss {
-                    beta: -0.05,
-                    keep: 0.95,
-                },
-                Effect::GyroBias { d_y: 0.12 },
             ]),
         ),
         (

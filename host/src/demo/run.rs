@@ -108,8 +108,7 @@ fn step<E: std::fmt::Display>(step: &'static str) -> impl Fn(E) -> DemoError {
     }
 }
 
-/// The effect a seed hides: one of the kinds diagnose names
-/// ([`crate::effects::diagnosed`]), drawn uniformly.
+/// The effect a seed hides: one of the library's nine, drawn uniformly.
 ///
 /// ```
 /// use yawcast::demo::hidden_kind;
@@ -120,8 +119,7 @@ fn step<E: std::fmt::Display>(step: &'static str) -> impl Fn(E) -> DemoError {
 pub fn hidden_kind(seed: u64) -> EffectKind {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(7);
-    let kinds = crate::effects::diagnosed();
-    kinds[rng.random_range(0..kinds.len())]
+    EffectKind::ALL[rng.random_range(0..EffectKind::ALL.len())]
 }
 
 fn fits_of(model: &Model, recs: &[Record]) -> Fits {

@@ -472,8 +472,9 @@ fn run(
     // an offset the model carries as the reference's own (identified on it) is tested for a
     // change on the trials; any other effect already in the model is skipped
     let own_offsets = has_ref && foreign_pct.is_none();
-    let kinds: Vec<EffectKind> = crate::effects::diagnosed()
-        .into_iter()
+    let kinds: Vec<EffectKind> = EffectKind::ALL
+        .iter()
+        .copied()
         .filter(|k| model.effect(*k).is_none() || (own_offsets && OFFSET_KINDS.contains(k)))
         .filter(|k| !(*k == EffectKind::Saturation && u_max <= 0.0))
         .collect();

@@ -71,8 +71,9 @@ pub(super) fn reference_actuator(
     reference: &[Record],
     cfg: &DiagnoseConfig,
 ) -> Option<RefOwn> {
-    let kinds: Vec<EffectKind> = crate::effects::diagnosed()
-        .into_iter()
+    let kinds: Vec<EffectKind> = EffectKind::ALL
+        .iter()
+        .copied()
         // the gear *dynamics* ([`Role::Actuator`]): a slow or delayed gear changes when the
         // rudder/pod angle arrives, which a linear model absorbs into its poles (a lag), so
         // with θ frozen the reference shows neither. A static limit or band θ cannot absorb,
@@ -128,7 +129,7 @@ pub(super) fn reference_hull(
     reference: &[Record],
     cfg: &DiagnoseConfig,
 ) -> Option<Model> {
-    own_search(base, reference, None, true, &cfg.augment).map(|f| f.model)
+    own_search(base, reference, None, &cfg.augment).map(|f| f.model)
 }
 
 /// The settings `model`'s structure is identified again with on other records (the

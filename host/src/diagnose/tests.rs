@@ -140,7 +140,7 @@ fn suite(
         })
         .collect();
     let mut labels: Vec<Option<EffectKind>> = vec![None];
-    labels.extend(crate::effects::diagnosed().into_iter().map(Some));
+    labels.extend(EffectKind::ALL.iter().map(|k| Some(*k)));
     println!("{title}: rows hidden, columns verdict");
     print!("{:>18}", "");
     for l in &labels {
@@ -178,9 +178,9 @@ fn right(out: &[(Option<EffectKind>, Option<EffectKind>)]) -> usize {
 fn acceptance_suite() {
     let t = std::time::Instant::now();
     let f = fixture();
-    let full: Vec<(Option<EffectKind>, u64)> = crate::effects::diagnosed()
-        .into_iter()
-        .flat_map(|k| (0..3).map(move |s| (Some(k), 11 + s)))
+    let full: Vec<(Option<EffectKind>, u64)> = EffectKind::ALL
+        .iter()
+        .flat_map(|k| (0..3).map(move |s| (Some(*k), 11 + s)))
         .collect();
     let nulls: Vec<(Option<EffectKind>, u64)> = (0..20).map(|s| (None, 40 + s)).collect();
     let full_out = suite(&f, &full, 1.0, "full strength");
@@ -427,7 +427,7 @@ fn missing_heading_and_speed_are_said() {
         "{}",
         d.explanation
     );
-    assert_eq!(d.ranking.len(), crate::effects::DIAGNOSED);
+    assert_eq!(d.ranking.len(), EffectKind::ALL.len());
     // an effect already in the model is not ranked again
     let with = m.clone().with_effect(Effect::DeadTime { samples: 1 });
     let d = diagnose(&with, &refs, &f, &[], &cfg).unwrap();

@@ -20,7 +20,7 @@ use crate::identify::predict::Horizon;
 use crate::io::data::Record;
 
 /// Number of effects tested (Bonferroni: each is judged at α / m).
-const TESTED: usize = crate::effects::DIAGNOSED;
+const TESTED: usize = EffectKind::ALL.len();
 
 /// Number of effects tested, as a divisor of α ([`TESTED`]).
 pub(super) fn cfg_m(_cfg: &DiagnoseConfig) -> f64 {

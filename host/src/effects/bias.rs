@@ -15,7 +15,6 @@ pub(super) const DEF: Def = Def {
     phrase: "a constant yaw moment",
     role: Role::Regressor,
     own: false,
-    diagnosed: true,
     channel: Channel::None,
     slow: true,
     gains: &[("beta", Regressor::One)],

@@ -15,7 +15,6 @@ pub(super) const DEF: Def = Def {
     phrase: "a current",
     role: Role::Regressor,
     own: false,
-    diagnosed: true,
     channel: Channel::SpeedOverGround,
     slow: true,
     gains: &[("beta_s", Regressor::Sin1), ("beta_c", Regressor::Cos1)],

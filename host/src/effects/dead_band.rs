@@ -13,7 +13,6 @@ pub(super) const DEF: Def = Def {
     phrase: "a steering-gear dead band",
     role: Role::Actuator { dynamics: false },
     own: true,
-    diagnosed: true,
     channel: Channel::None,
     slow: false,
     gains: &[],

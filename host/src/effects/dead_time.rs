@@ -11,7 +11,6 @@ pub(super) const DEF: Def = Def {
     phrase: "a command dead time",
     role: Role::Actuator { dynamics: true },
     own: true,
-    diagnosed: true,
     channel: Channel::None,
     slow: false,
     gains: &[],

@@ -44,8 +44,6 @@ pub enum Regressor {
     Starboard,
     /// `φ = y|y|` or `y³`.
     Damping,
-    /// `φ = ũ·s`, `s` the squared rate through the speed-loss lag.
-    SpeedLoss,
     /// `φ = sin 2ψ`.
     Sin2,
     /// `φ = cos 2ψ`.
@@ -119,10 +117,6 @@ pub struct Def {
     /// less than linearly with the angle an angle limit re-identified on the reference
     /// stands for that hull physics, and the words say so.
     pub own: bool,
-    /// Diagnose tests it on trials and may name it; `false` for physics every record has
-    /// that diagnose cannot tell from the reference's (the speed lost in turns), which
-    /// `augment --effect auto` still adds when the reference records pay for it.
-    pub diagnosed: bool,
     /// The channel besides the yaw rate that shows it.
     pub channel: Channel,
     /// Judged on the long-horizon errors (a slow, steady effect) rather than the one-step
@@ -178,8 +172,6 @@ pub struct SimKnobs {
     pub wind_ne: (f64, f64),
     /// Current velocity, north/east components (m/s).
     pub current_ne: (f64, f64),
-    /// Extra non-dimensional surge resistance in turns (`X = −x_rr·½ρL³d·r²`).
-    pub x_rr: f64,
 }
 
 impl Default for SimKnobs {
@@ -196,7 +188,6 @@ impl Default for SimKnobs {
             cubic: false,
             wind_ne: (0.0, 0.0),
             current_ne: (0.0, 0.0),
-            x_rr: 0.0,
         }
     }
 }

@@ -13,7 +13,6 @@ pub(super) const DEF: Def = Def {
     phrase: "a rate-gyro offset",
     role: Role::Output,
     own: false,
-    diagnosed: true,
     channel: Channel::Heading,
     slow: true,
     gains: &[("d_y", Regressor::Offset)],

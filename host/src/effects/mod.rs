@@ -34,7 +34,6 @@ mod gyro_bias;
 mod nonlinear_damping;
 mod rate_limit;
 mod saturation;
-mod speed_loss;
 mod wind;
 
 pub use asymmetry::HIDDEN_ASYMMETRY;
@@ -49,7 +48,6 @@ pub use gyro_bias::HIDDEN_GYRO_BIAS_DEGPS;
 pub use nonlinear_damping::HIDDEN_N_RR;
 pub use rate_limit::HIDDEN_RATE_DEGPS;
 pub use saturation::HIDDEN_LIMIT_DEG;
-pub use speed_loss::HIDDEN_X_RR;
 pub use wind::HIDDEN_WIND_MPS;
 
 /// The registry: the definition of each kind of the library.
@@ -75,28 +73,7 @@ pub fn def(kind: EffectKind) -> &'static Def {
         EffectKind::Wind => &wind::DEF,
         EffectKind::Current => &current::DEF,
         EffectKind::DeadBand => &dead_band::DEF,
-        EffectKind::SpeedLoss => &speed_loss::DEF,
     }
-}
-
-/// How many kinds diagnose tests on trials: the length of [`diagnosed`].
-pub const DIAGNOSED: usize = EffectKind::ALL.len() - 1;
-
-/// The kinds diagnose tests on trials ([`Def::diagnosed`]), in library order: every kind
-/// but the speed lost in turns ([`DIAGNOSED`] of them).
-///
-/// ```
-/// use yawcast::effects::diagnosed;
-/// use yawcast_shared::model::EffectKind;
-/// assert_eq!(diagnosed().len(), EffectKind::ALL.len() - 1);
-/// assert!(!diagnosed().contains(&EffectKind::SpeedLoss));
-/// assert_eq!(diagnosed().len(), yawcast::effects::DIAGNOSED);
-/// ```
-pub fn diagnosed() -> Vec<EffectKind> {
-    EffectKind::ALL
-        .into_iter()
-        .filter(|k| def(*k).diagnosed)
-        .collect()
 }
 
 /// One library effect with f64 parameters (see `yawcast_shared::model::Effect` for physics).
@@ -163,14 +140,6 @@ pub enum Effect {
         /// b (deg).
         width: f64,
     },
-    /// The rudder's force lost with the speed in turns: `φ = ũ·s` through B, `s(t) =
-    /// keep·s(t−1) + (1 − keep)·ρ²`.
-    SpeedLoss {
-        /// Gain β.
-        beta: f64,
-        /// The lag's factor kept per sample, `e^(−1/lag)` for a lag in samples.
-        keep: f64,
-    },
 }
 
 impl Effect {
@@ -192,7 +161,6 @@ impl Effect {
             Effect::Wind { .. } => EffectKind::Wind,
             Effect::Current { .. } => EffectKind::Current,
             Effect::DeadBand { .. } => EffectKind::DeadBand,
-            Effect::SpeedLoss { .. } => EffectKind::SpeedLoss,
         }
     }
 
@@ -233,10 +201,6 @@ impl Effect {
                 beta_s: 0.0,
                 beta_c: 0.0,
             },
-            EffectKind::SpeedLoss => Effect::SpeedLoss {
-                beta: 0.0,
-                keep: 0.0,
-            },
         };
         e.set_structural(structural);
         e
@@ -261,8 +225,7 @@ impl Effect {
             | Effect::Asymmetry { .. }
             | Effect::NonlinearDamping { .. }
             | Effect::Wind { .. }
-            | Effect::Current { .. }
-            | Effect::SpeedLoss { .. } => None,
+            | Effect::Current { .. } => None,
         }
     }
 
@@ -279,8 +242,7 @@ impl Effect {
             | Effect::Asymmetry { .. }
             | Effect::NonlinearDamping { .. }
             | Effect::Wind { .. }
-            | Effect::Current { .. }
-            | Effect::SpeedLoss { .. } => {}
+            | Effect::Current { .. } => {}
         }
     }
 
@@ -293,7 +255,7 @@ impl Effect {
     pub fn gains(&self) -> Vec<f64> {
         match *self {
             Effect::Bias { beta } | Effect::Asymmetry { beta } => vec![beta],
-            Effect::NonlinearDamping { beta, .. } | Effect::SpeedLoss { beta, .. } => vec![beta],
+            Effect::NonlinearDamping { beta, .. } => vec![beta],
             Effect::GyroBias { d_y } => vec![d_y],
             Effect::Wind {
                 beta_s2,
@@ -313,7 +275,7 @@ impl Effect {
     pub fn set_gains(&mut self, g: &[f64]) {
         match self {
             Effect::Bias { beta } | Effect::Asymmetry { beta } => *beta = g[0],
-            Effect::NonlinearDamping { beta, .. } | Effect::SpeedLoss { beta, .. } => *beta = g[0],
+            Effect::NonlinearDamping { beta, .. } => *beta = g[0],
             Effect::GyroBias { d_y } => *d_y = g[0],
             Effect::Wind {
                 beta_s2,
@@ -390,7 +352,6 @@ impl Effect {
                 beta_c1,
             },
             Effect::Current { beta_s, beta_c } => sm::Effect::Current { beta_s, beta_c },
-            Effect::SpeedLoss { beta, keep } => sm::Effect::SpeedLoss { beta, keep },
         }
     }
 
@@ -421,7 +382,6 @@ impl Effect {
                 beta_c1,
             },
             sm::Effect::Current { beta_s, beta_c } => Effect::Current { beta_s, beta_c },
-            sm::Effect::SpeedLoss { beta, keep } => Effect::SpeedLoss { beta, keep },
         }
     }
 
@@ -451,7 +411,6 @@ impl Effect {
                 beta_c1,
             } => wind::describe([beta_s2, beta_c2, beta_s1, beta_c1]),
             Effect::Current { beta_s, beta_c } => current::describe(beta_s, beta_c),
-            Effect::SpeedLoss { beta, keep } => speed_loss::describe(beta, keep, ts),
         }
     }
 
@@ -473,7 +432,6 @@ impl Effect {
             }
             Effect::Wind { .. } => wind::evidence(pct, slow_h, p_yaw),
             Effect::Current { .. } => current::evidence(pct, slow_h, p_yaw),
-            Effect::SpeedLoss { beta, keep } => speed_loss::evidence(beta, keep, ts, pct),
         }
     }
 
@@ -501,8 +459,7 @@ impl Effect {
             | Effect::Saturation { .. }
             | Effect::DeadBand { .. }
             | Effect::Asymmetry { .. }
-            | Effect::NonlinearDamping { .. }
-            | Effect::SpeedLoss { .. } => None,
+            | Effect::NonlinearDamping { .. } => None,
         }
     }
 
@@ -529,7 +486,6 @@ impl Effect {
             Effect::Bias { beta } => SimCounterpart::Moment { beta },
             Effect::NonlinearDamping { beta, cubic } => SimCounterpart::Damping { beta, cubic },
             Effect::Wind { .. } | Effect::Current { .. } => SimCounterpart::Heading,
-            Effect::SpeedLoss { .. } => SimCounterpart::Unmapped,
         }
     }
 }
@@ -553,10 +509,6 @@ pub enum SimCounterpart {
     },
     /// A heading-dependent moment ([`Effect::harmonics`]).
     Heading,
-    /// No conversion yet: the speed lost in turns, which the simulators' hulls have of
-    /// their own (an extra resistance in turns, [`SimEffect::SpeedLoss`], is not calibrated
-    /// from a model's gain).
-    Unmapped,
 }
 
 /// One physical effect the simulator can switch on, with its physical parameters.
@@ -636,12 +588,6 @@ pub enum SimEffect {
         /// Width (deg), `> 0`.
         width_deg: f64,
     },
-    /// Extra surge resistance in turns (a hull that loses more speed in a turn than its
-    /// own): `X = −x_rr·½ρL³d·r²`.
-    SpeedLoss {
-        /// Non-dimensional coefficient, `>= 0`.
-        x_rr: f64,
-    },
 }
 
 impl SimEffect {
@@ -665,7 +611,6 @@ impl SimEffect {
             SimEffect::Wind { .. } => EffectKind::Wind,
             SimEffect::Current { .. } => EffectKind::Current,
             SimEffect::DeadBand { .. } => EffectKind::DeadBand,
-            SimEffect::SpeedLoss { .. } => EffectKind::SpeedLoss,
         }
     }
 
@@ -725,7 +670,6 @@ impl SimEffect {
                 towards_deg,
             } => current::describe_sim(speed_mps, towards_deg),
             SimEffect::DeadBand { width_deg } => dead_band::describe_sim(width_deg),
-            SimEffect::SpeedLoss { x_rr } => speed_loss::describe_sim(x_rr),
         }
     }
 
@@ -766,7 +710,6 @@ impl SimEffect {
                 towards_deg,
             } => current::fields(speed_mps, towards_deg),
             SimEffect::DeadBand { width_deg } => dead_band::fields(width_deg),
-            SimEffect::SpeedLoss { x_rr } => speed_loss::fields(x_rr),
         };
         for f in fields.iter().flatten() {
             check(f.name, f.value, f.ok, f.expected)?;
@@ -793,7 +736,6 @@ impl SimEffect {
                 towards_deg,
             } => current::apply(speed_mps, towards_deg, k),
             SimEffect::DeadBand { width_deg } => dead_band::apply(width_deg, k),
-            SimEffect::SpeedLoss { x_rr } => speed_loss::apply(x_rr, k),
         }
     }
 
@@ -817,8 +759,7 @@ impl SimEffect {
             SimEffect::Saturation { .. }
             | SimEffect::DeadBand { .. }
             | SimEffect::Asymmetry { .. }
-            | SimEffect::NonlinearDamping { .. }
-            | SimEffect::SpeedLoss { .. } => *self,
+            | SimEffect::NonlinearDamping { .. } => *self,
         }
     }
 }

@@ -12,7 +12,6 @@ pub(super) const DEF: Def = Def {
     phrase: "extra nonlinear yaw damping",
     role: Role::Regressor,
     own: true,
-    diagnosed: true,
     channel: Channel::None,
     slow: false,
     gains: &[("beta", Regressor::Damping)],

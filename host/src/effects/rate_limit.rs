@@ -17,7 +17,6 @@ pub(super) const DEF: Def = Def {
     phrase: "a rudder/pod slew-rate limit",
     role: Role::Actuator { dynamics: true },
     own: true,
-    diagnosed: true,
     channel: Channel::None,
     slow: false,
     gains: &[],

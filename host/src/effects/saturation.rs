@@ -13,7 +13,6 @@ pub(super) const DEF: Def = Def {
     // static: θ cannot absorb it (it changes the gain at large angles, not the dynamics)
     role: Role::Actuator { dynamics: false },
     own: true,
-    diagnosed: true,
     channel: Channel::None,
     slow: false,
     gains: &[],

@@ -98,7 +98,6 @@ fn knobs_read_the_effects() {
     assert_eq!(k.gyro_bias_degps, HIDDEN_GYRO_BIAS_DEGPS);
     assert_eq!(k.starboard_gain, HIDDEN_ASYMMETRY);
     assert_eq!((k.n_rr, k.cubic), (HIDDEN_N_RR, false));
-    assert_eq!(k.x_rr, HIDDEN_X_RR);
     // wind from 045° blows towards 225°: both components negative
     assert!(k.wind_ne.0 < 0.0 && k.wind_ne.1 < 0.0);
     assert!((k.wind_ne.0.hypot(k.wind_ne.1) - HIDDEN_WIND_MPS).abs() < 1e-12);

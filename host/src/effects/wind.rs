@@ -15,7 +15,6 @@ pub(super) const DEF: Def = Def {
     phrase: "a heading-dependent wind moment",
     role: Role::Regressor,
     own: false,
-    diagnosed: true,
     channel: Channel::SpeedOverGround,
     slow: true,
     gains: &[

@@ -7,9 +7,8 @@
 //! 2. heading `ψ` = measured ψ when given, else the integrated `ψ̂`;
 //! 3. `y_used` = measured y when finite, else `ŷ = x̂₁ + d_y`; the hull's rate
 //!    `ρ = y_used − d_y`;
-//! 4. the speed-loss lag `s = keep·s + (1 − keep)·ρ²`, then `v = ũ + Σ β φ`
-//!    (`yawcast_shared::kernel::Step::effective_input`: bias 1, asymmetry max(ũ,0), damping
-//!    ρ|ρ| or ρ³, speed loss ũ·s, wind sin2ψ, cos2ψ, sinψ, cosψ, current sinψ, cosψ; ψ in
+//! 4. `v = ũ + Σ β φ` (`yawcast_shared::kernel::Step::effective_input`: bias 1, asymmetry
+//!    max(ũ,0), damping ρ|ρ| or ρ³, wind sin2ψ, cos2ψ, sinψ, cosψ, current sinψ, cosψ; ψ in
 //!    degrees), accumulated one term at a time;
 //! 5. `e = y − ŷ` (0 when y is missing);
 //! 6. `x̂' = A x̂ + B v + K e`;
@@ -87,8 +86,6 @@ pub struct State {
     pub u_prev: f64,
     /// Integrated heading ψ̂ (deg).
     pub psi: f64,
-    /// The speed-loss lag `s` (zero without the effect).
-    pub turn: f64,
 }
 
 impl Clone for State {
@@ -98,7 +95,6 @@ impl Clone for State {
             delay: self.delay.clone(),
             u_prev: self.u_prev,
             psi: self.psi,
-            turn: self.turn,
         }
     }
 
@@ -109,7 +105,6 @@ impl Clone for State {
         self.delay.clone_from(&o.delay);
         self.u_prev = o.u_prev;
         self.psi = o.psi;
-        self.turn = o.turn;
     }
 }
 
@@ -171,7 +166,6 @@ impl Stepper {
             delay: vec![0.0; self.d],
             u_prev: 0.0,
             psi: psi0,
-            turn: 0.0,
         }
     }
 
@@ -201,20 +195,10 @@ impl Stepper {
     }
 
     /// The effective input `v = ũ + Σβφ` for actuator output `ut`, the hull's rate `rate`
-    /// (the yaw rate used less the gyro offset `d_y`), heading `psi` (deg) and the
-    /// speed-loss lag of this step `turn`, accumulated as the firmware does.
-    pub fn effective_input(&self, ut: f64, rate: f64, psi: f64, turn: f64) -> f64 {
-        self.fx.effective_input(ut, rate, psi, turn)
-    }
-
-    /// The speed-loss lag's next value (`yawcast_shared::kernel::Step::turn`).
-    pub fn turn(&self, turn: f64, rate: f64) -> f64 {
-        self.fx.turn(turn, rate)
-    }
-
-    /// The speed-loss lag's `keep` and gain, when the model has the effect.
-    pub fn speed_loss(&self) -> Option<(f64, f64)> {
-        self.fx.speed.map(|[beta, keep, _]| (keep, beta))
+    /// (the yaw rate used less the gyro offset `d_y`), heading `psi` (deg), accumulated as
+    /// the firmware does.
+    pub fn effective_input(&self, ut: f64, rate: f64, psi: f64) -> f64 {
+        self.fx.effective_input(ut, rate, psi)
     }
 
     /// One filter step with command `u`, measurement `y` (NaN = missing) and optional
@@ -232,8 +216,7 @@ impl Stepper {
             (yhat, 0.0)
         };
         let rate = y_used - self.d_y;
-        st.turn = self.fx.turn(st.turn, rate);
-        let v = self.effective_input(ut, rate, psi, st.turn);
+        let v = self.effective_input(ut, rate, psi);
         let n = self.n;
         let x = st.x;
         let mut last = 0.0;

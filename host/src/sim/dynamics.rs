@@ -54,8 +54,6 @@ pub(crate) struct Model {
     pub(crate) asym: f64,
     pub(crate) n_rr: f64,
     pub(crate) cubic: bool,
-    /// Extra surge resistance in turns (`speed-loss`), `x_rr·½ρL³d` (N·s²).
-    pub(crate) x_turn: f64,
     /// True wind towards (N, E) components (m/s).
     pub(crate) wind_ne: (f64, f64),
     /// Current (N, E) components (m/s).
@@ -130,7 +128,6 @@ impl Model {
             asym: 0.0,
             n_rr: 0.0,
             cubic: false,
-            x_turn: 0.0,
             wind_ne: (0.0, 0.0),
             current_ne: (0.0, 0.0),
         };
@@ -139,7 +136,6 @@ impl Model {
         model.asym = k.starboard_gain;
         model.n_rr = k.n_rr;
         model.cubic = k.cubic;
-        model.x_turn = k.x_rr * half_rho_l2d * l;
         model.wind_ne = k.wind_ne;
         model.current_ne = k.current_ne;
         model
@@ -274,11 +270,7 @@ impl Model {
                 self.n_rr * self.half_rho_l4d * r * r.abs()
             };
         }
-        (
-            xh + xp + xa - self.x_turn * r * r,
-            yh + yp + ya,
-            nh + np + na + ne,
-        )
+        (xh + xp + xa, yh + yp + ya, nh + np + na + ne)
     }
 
     /// Time derivative of the state.

@@ -97,7 +97,6 @@ fn unit(kind: EffectKind, cubic: bool) -> &'static str {
         EffectKind::Asymmetry => "fraction",
         EffectKind::NonlinearDamping if cubic => "° of command per (°/s)³",
         EffectKind::NonlinearDamping => "° of command per (°/s)²",
-        EffectKind::SpeedLoss => "per (°/s)²",
         EffectKind::Wind | EffectKind::Current => "",
     }
 }

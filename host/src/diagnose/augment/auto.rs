@@ -78,21 +78,17 @@ pub fn auto_kinds(
 /// held-out third of the reference pays for it — judged against the structure
 /// re-identified on the first two thirds alone (the reference model saw the held-out third
 /// too), the damping in whichever form the reference favours. `None` when it keeps none,
-/// or keeps an unstable model. `diagnosed_only`: only kinds diagnose tests
-/// ([`crate::effects::Def::diagnosed`]) — diagnose's nulls, which were calibrated without
-/// the speed lost in turns.
+/// or keeps an unstable model.
 pub(crate) fn own_search(
     start: &Model,
     reference: &[Record],
     except: Option<EffectKind>,
-    diagnosed_only: bool,
     cfg: &AugmentConfig,
 ) -> Option<ForwardReport> {
     let kinds: Vec<EffectKind> = EffectKind::ALL
         .iter()
         .copied()
         .filter(|k| def(*k).own && def(*k).role != Role::Actuator { dynamics: true })
-        .filter(|k| def(*k).diagnosed || !diagnosed_only)
         .filter(|k| start.effect(*k).is_none() && except != Some(*k))
         .collect();
     if kinds.is_empty() || reference.is_empty() {
@@ -171,13 +167,7 @@ pub fn own_base(
     let theirs = |k: EffectKind| dynamics(k) && trial_effects.contains(&k);
     let start = gear.unwrap_or_else(|| given.clone());
     let n_gear = beyond(&start).iter().filter(|e| !theirs(e.kind())).count();
-    let searched = own_search(
-        &start,
-        reference,
-        trial_effects.first().copied(),
-        false,
-        cfg,
-    );
+    let searched = own_search(&start, reference, trial_effects.first().copied(), cfg);
     let (mut model, held_out) = match searched {
         Some(f) => {
             let fits = f.fit10_without_and_with();

@@ -10,8 +10,7 @@ use crate::io::data::Record;
 use crate::sim::{self, Scenario, Ship, SimEffect};
 /// Converts an identified model effect into the simulator's physical parameters, for writing
 /// it into a ship file (`--ship`). `None` when the effect has no physical counterpart in the
-/// simulator (damping identified with the wrong sign, the speed lost in turns, which the
-/// simulator's hull has of its own) or a calibration run fails.
+/// simulator (damping identified with the wrong sign) or a calibration run fails.
 ///
 /// Conversions and their approximations:
 /// - dead time: `samples·Ts` (the simulator's delay acts before its own servo lag);
@@ -43,7 +42,6 @@ pub fn to_sim_effect(effect: &Effect, model: &Model, ship: &Ship) -> Option<SimE
         SimCounterpart::Moment { beta } => bias_to_moment(beta, ship)?,
         SimCounterpart::Damping { beta, cubic } => damping_to_nrr(beta, cubic, model, ship)?,
         SimCounterpart::Heading => heading_effect(effect, model, ship)?,
-        SimCounterpart::Unmapped => return None,
     };
     e.validate("effect").ok()?;
     Some(e)

@@ -595,36 +595,3 @@ fn an_offset_the_heading_measures_is_kept_beside_a_steady_moment() {
         r.explanation
     );
 }
-
-#[test]
-fn the_speed_lost_in_turns_is_the_ships_own_and_predicts_a_fresh_record_better() {
-    // Mariner's speed falls in every turn of its zig-zags and its rudder's force with it: on
-    // the effect-free reference records the search for the ship's own physics keeps the
-    // speed loss (its gain negative: a slower ship turns less), the model predicts a fresh
-    // record better at 10 steps than the search without it, and diagnose's nulls (the search
-    // over the kinds diagnose tests) do not carry it
-    use crate::diagnose::tests::{identify, world_records};
-    use crate::sim::WorldKind;
-    let k = WorldKind::Mariner;
-    let reference = world_records(k, Vec::new(), &[900, 901, 902]);
-    let model = identify(&reference);
-    let cfg = AugmentConfig::default();
-    let with = own_search(&model, &reference, None, false, &cfg).expect("a search that keeps");
-    let Some(&Effect::SpeedLoss { beta, keep }) = with.model.effect(EffectKind::SpeedLoss) else {
-        panic!("kept {:?}", with.added)
-    };
-    let lag = -1.0 / keep.ln();
-    println!(
-        "speed loss: β {beta:.4}, lag {lag:.0} samples; kept {:?}",
-        with.added
-    );
-    assert!(beta < 0.0, "{beta}");
-    assert!((5.0..=450.0).contains(&lag), "{lag}");
-    let without = own_search(&model, &reference, None, true, &cfg).expect("a search that keeps");
-    assert!(without.model.effect(EffectKind::SpeedLoss).is_none());
-    let fresh = world_records(k, Vec::new(), &[150]);
-    let fit = |m: &Model| predict::fit_at(m, &fresh[0], predict::Horizon::Steps(10));
-    let (a, b) = (fit(&without.model), fit(&with.model));
-    println!("fresh record, 10 steps: {a:.2} % without the speed loss, {b:.2} % with it");
-    assert!(b > a + 0.3, "{a} → {b}");
-}

@@ -151,12 +151,11 @@ impl Problem<'_> {
             }
             accs = self.jac(&params, &x0);
             if !self.lay.heading
-                && self.lay.gains.iter().all(|g| {
-                    !matches!(
-                        g,
-                        crate::effects::Regressor::Damping | crate::effects::Regressor::SpeedLoss
-                    )
-                })
+                && self
+                    .lay
+                    .gains
+                    .iter()
+                    .all(|g| *g != crate::effects::Regressor::Damping)
             {
                 break;
             }

@@ -221,7 +221,6 @@ fn pass_n<const N: usize, S: Sink>(
     let gains = model.effect_gains();
     // β of damping and of the heading regressors, for the y and ψ partials of v.
     let mut damp = 0.0;
-    let speed = stepper.speed_loss();
     let mut hb = [0.0f64; 4]; // of sin 2ψ, cos 2ψ, sin ψ, cos ψ (wind and current summed)
     for (j, g) in lay.gains.iter().enumerate() {
         match g {
@@ -230,7 +229,7 @@ fn pass_n<const N: usize, S: Sink>(
             Regressor::Cos2 => hb[1] += gains[j],
             Regressor::Sin1 => hb[2] += gains[j],
             Regressor::Cos1 => hb[3] += gains[j],
-            Regressor::One | Regressor::Offset | Regressor::Starboard | Regressor::SpeedLoss => {}
+            Regressor::One | Regressor::Offset | Regressor::Starboard => {}
         }
     }
     let dy_col = lay.dy.unwrap_or(usize::MAX);
@@ -241,8 +240,6 @@ fn pass_n<const N: usize, S: Sink>(
         sx[p + i][i] = 1.0;
     }
     let mut spsi = vec![0.0f64; q];
-    // and of the speed-loss lag s
-    let mut sturn = vec![0.0f64; q];
     let mut row = vec![0.0f64; q];
     let mut active = q;
     let mut phi = vec![0.0f64; lay.gains.len()];
@@ -279,7 +276,6 @@ fn pass_n<const N: usize, S: Sink>(
                         z * z.abs()
                     }
                 }
-                Regressor::SpeedLoss => o.u_eff * st.turn,
                 Regressor::Sin2 => s2,
                 Regressor::Cos2 => c2,
                 Regressor::Sin1 => s1,
@@ -311,12 +307,6 @@ fn pass_n<const N: usize, S: Sink>(
                 0.0
             };
             let mut dv = dv_dz * (dyu - ddy) + dv_dpsi * dpsi;
-            if let Some((keep, beta)) = speed {
-                // s = keep·s⁻ + (1 − keep)·z², φ = ũ·s
-                let ds = keep * sturn[j] + (1.0 - keep) * 2.0 * z * (dyu - ddy);
-                sturn[j] = ds;
-                dv += beta * o.u_eff * ds;
-            }
             if j >= nt && j < p {
                 dv += phi[j - nt];
             }
@@ -349,7 +339,7 @@ fn pass_n<const N: usize, S: Sink>(
             let mut m = 0.0f64;
             for j in p..q {
                 m = sx[j][..n].iter().fold(m, |m, v| m.max(v.abs()));
-                m = m.max(spsi[j].abs()).max(sturn[j].abs());
+                m = m.max(spsi[j].abs());
             }
             if m < X0_CUTOFF {
                 active = p;
@@ -478,10 +468,6 @@ pub(crate) mod tests {
             })
             .with_effect(Effect::GyroBias { d_y: 0.1 })
             .with_effect(Effect::Asymmetry { beta: 0.05 })
-            .with_effect(Effect::SpeedLoss {
-                beta: -0.02,
-                keep: 0.9,
-            })
             .with_effect(Effect::DeadTime { samples: 1 });
         let r = record(300, true);
         let err = jacobian_error(&m, &r, &[0.3, -0.1, 0.2, 0.05]);
@@ -501,11 +487,7 @@ pub(crate) mod tests {
                 beta_s1: -0.1,
                 beta_c1: 0.05,
             })
-            .with_effect(Effect::GyroBias { d_y: 0.1 })
-            .with_effect(Effect::SpeedLoss {
-                beta: -0.03,
-                keep: 0.8,
-            });
+            .with_effect(Effect::GyroBias { d_y: 0.1 });
         let mut r = record(300, false);
         for t in (5..300).step_by(17) {
             r.y[t] = f64::NAN;

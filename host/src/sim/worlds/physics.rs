@@ -33,8 +33,6 @@ pub(super) struct Physics {
     pub(super) half_rho_l2d: f64,
     pub(super) half_rho_l4d: f64,
     pub(super) lpp: f64,
-    /// Extra surge resistance in turns (`speed-loss`), `x_rr·½ρL³d` (N·s²).
-    pub(super) x_turn: f64,
 }
 
 /// One sample's random environment: background moment (N·m) and gust factor.
@@ -72,7 +70,6 @@ impl Physics {
             half_rho_l2d: 0.5 * rho * l * l * d,
             half_rho_l4d: 0.5 * rho * l.powi(4) * d,
             lpp: l,
-            x_turn: k.x_rr * 0.5 * rho * l.powi(3) * d,
         };
         p.bias_nm = k.yaw_moment_nm;
         p.gyro_bias = k.gyro_bias_degps;
@@ -131,7 +128,6 @@ impl Physics {
                 self.n_rr * self.half_rho_l4d * r * r.abs()
             };
         }
-        let xa = xa - self.x_turn * r * r;
         let a = hull.accel_roll([s[0], s[1], r, s[6], s[7]], delta, [xa, ya, n]);
         let (vn, ve) = self.ground_velocity(s);
         [a[0], a[1], a[2], vn, ve, r * s[7].cos(), a[3], s[6]]
