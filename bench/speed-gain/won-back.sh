@@ -95,26 +95,7 @@ for w in "${world_list[@]}"; do
         -printf "$w %p\n"
 done | sort | xargs -P "$jobs" -L 1 bash -c 'case_turn "$@"' _ | sort >"$runs/turn$tau.tsv"
 
-python3 - "$runs/turn$tau.tsv" "$tau" "$lag" <<'EOF'
-import collections, statistics, sys
-rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
-print(f"| world | effect | strength | seed | oracle | linear | augmented | with the turn's "
-      f"speed (T = {sys.argv[2]} s, lag {sys.argv[3]}) | won back | with the turn's speed |")
-print("|---|---|---|---|---|---|---|---|---|---|")
-by = collections.defaultdict(list)
-for w, e, st, s, o, lin, a, t in rows:
-    o, lin, a, t = map(float, (o, lin, a, t))
-    if o - lin < 3.0:
-        continue
-    wa, wt = (a - lin) / (o - lin), (t - lin) / (o - lin)
-    by[(w, st)].append((wa, wt))
-    print(f"| {w} | {e} | {st} | {s} | {o:.2f} | {lin:.2f} | {a:.2f} | {t:.2f} | "
-          f"{100 * wa:.1f} % | {100 * wt:.1f} % |")
-print("\n| world | strength | cases with a loss ≥ 3 pp | median won back | with the turn's speed |")
-print("|---|---|---|---|---|")
-for (w, st), v in sorted(by.items()):
-    print(f"| {w} | {st} | {len(v)} | {100 * statistics.median(x for x, _ in v):.1f} % | "
-          f"{100 * statistics.median(y for _, y in v):.1f} % |")
-EOF
+python3 "$repo/bench/worlds/won_back_table.py" "$runs/turn$tau.tsv" \
+    "with the turn's speed (T = $tau s, lag $lag)"
 exit 0
 }
